@@ -1,0 +1,19 @@
+"""hybridsub: subdivision surfaces that keep their sharp features.
+
+The hybrid √3–Loop scheme of Abd El-Latif (2014) — Kobbelt's √3 on smooth faces, Loop's
+1-to-4 split on sharp faces, creases split instead of flipped — and its two parents,
+Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
+
+>>> import numpy as np, hybridsub
+>>> V, F = hybridsub.load_example()
+>>> V2, F2 = hybridsub.subdivide(V, F, levels=1, scheme="sqrt3")
+>>> len(F2) == 3 * len(F)
+True
+"""
+
+from ._errors import MeshError
+from ._examples import load_example
+from ._refine import Refinement, RefinementStep, refine, subdivide
+
+__all__ = ["subdivide", "refine", "Refinement", "RefinementStep", "MeshError", "load_example"]
+__version__ = "0.1.0"

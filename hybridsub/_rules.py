@@ -1,0 +1,134 @@
+"""The scheme's rules as pure functions of a vertex's neighbourhood numbers.
+
+Nothing here knows a mesh: every function takes valences, region codes or sharpness
+values (scalars or arrays) and returns weights. The topology layer decides which rule
+applies where; the matrix layer turns the weights into rows of S.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# Vertex rules (OpenSubdiv's Sdc calls them the same). A dart (one crease edge) is SMOOTH.
+SMOOTH = 0
+CREASE = 1
+CORNER = 2
+
+# Regions of a smooth vertex: which scheme's faces surround it.
+REGION_SQRT3 = 0
+REGION_LOOP = 1
+REGION_MIXED = 2
+
+# Edge kinds of one step.
+EDGE_FLIP = 0  # sqrt3 edge flip: no point on it
+EDGE_SPLIT = 1  # one edge point (crease or split-smooth)
+EDGE_TRISECT = 2  # Kobbelt's even-step boundary: two points e1, e2
+EDGE_KEEP = 3  # Kobbelt's odd-step boundary: kept as it is
+
+#: Sharpness at or above this value is infinite (OpenSubdiv's SHARPNESS_INFINITE).
+INFINITE_SHARPNESS = 10.0
+
+#: Crease vertex mask (self, each of the two crease neighbours): Hoppe's B2 rule.
+CREASE_MASK = (3.0 / 4.0, 1.0 / 8.0)
+#: Kobbelt's even-step boundary vertex mask (self, each boundary neighbour).
+KOBBELT_BOUNDARY_MASK = (19.0 / 27.0, 4.0 / 27.0)
+#: Kobbelt's boundary trisection point e1 = (p_{i-1} + 16 p_i + 10 p_{i+1}) / 27.
+KOBBELT_TRISECTION = (1.0 / 27.0, 16.0 / 27.0, 10.0 / 27.0)
+
+LOOP_WEIGHTS = ("loop", "warren")
+
+
+def kobbelt_alpha(n):
+    """Kobbelt's √3 smoothing weight α_n = (4 − 2 cos(2π/n)) / 9.
+
+    Examples
+    --------
+    >>> float(kobbelt_alpha(6))
+    0.3333333333333333
+    """
+    n = np.asarray(n, dtype=np.float64)
+    return (4.0 - 2.0 * np.cos(2.0 * np.pi / n)) / 9.0
+
+
+def loop_beta(n, loop_weights="loop"):
+    """Loop's per-neighbour weight β_n.
+
+    ``"loop"``: β_n = (5/8 − (3/8 + 1/4 cos(2π/n))²) / n; ``"warren"``: 3/16 for n = 3,
+    3/(8n) otherwise.
+
+    Examples
+    --------
+    >>> float(loop_beta(6))
+    0.0625
+    >>> float(loop_beta(4, "warren"))
+    0.09375
+    """
+    n = np.asarray(n, dtype=np.float64)
+    if loop_weights == "loop":
+        c = 3.0 / 8.0 + 0.25 * np.cos(2.0 * np.pi / n)
+        return (5.0 / 8.0 - c * c) / n
+    if loop_weights == "warren":
+        return np.where(n == 3, 3.0 / 16.0, 3.0 / (8.0 * n))
+    raise ValueError(f"loop_weights must be one of {LOOP_WEIGHTS}, got {loop_weights!r}")
+
+
+def mixed_alpha(n):
+    """Weight α of the neighbour average at a vertex where √3 and Loop faces meet.
+
+    The paper's R3 table: 9/16 for n = 3 (3/16 per neighbour), 3/8 for n = 4, 5,
+    Kobbelt's α_n for n ≥ 6.
+
+    Examples
+    --------
+    >>> [float(a) for a in mixed_alpha([3, 4, 5])]
+    [0.5625, 0.375, 0.375]
+    """
+    n = np.asarray(n, dtype=np.float64)
+    return np.where(n == 3, 9.0 / 16.0, np.where(n < 6, 3.0 / 8.0, kobbelt_alpha(n)))
+
+
+def smooth_neighbour_weight(n, region, loop_weights="loop"):
+    """Per-neighbour weight of the smooth vertex mask, by region; 0 where n = 0.
+
+    The vertex keeps 1 − n · weight of itself.
+
+    Examples
+    --------
+    >>> smooth_neighbour_weight([6, 6], [REGION_SQRT3, REGION_LOOP]).tolist()
+    [0.05555555555555555, 0.0625]
+    """
+    n = np.asarray(n, dtype=np.int64)
+    region = np.asarray(region)
+    safe = np.maximum(n, 1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.where(
+            region == REGION_SQRT3,
+            kobbelt_alpha(safe) / safe,
+            np.where(region == REGION_LOOP, loop_beta(safe, loop_weights), mixed_alpha(safe) / safe),
+        )
+    return np.where(n > 0, w, 0.0)
+
+
+def vertex_rule(crease_count, is_corner):
+    """Rule of a vertex from its number of incident creases and its corner tag."""
+    c = np.asarray(crease_count)
+    return np.where(is_corner | (c >= 3), CORNER, np.where(c == 2, CREASE, SMOOTH)).astype(np.int8)
+
+
+def child_sharpness(s):
+    """Sharpness of a crease's children: s − 1, infinite stays infinite, ≤ 0 means smooth.
+
+    Examples
+    --------
+    >>> child_sharpness(np.array([0.5, 2.5, np.inf])).tolist()
+    [0.0, 1.5, inf]
+    """
+    s = np.asarray(s, dtype=np.float64)
+    return np.where(np.isinf(s), s, np.maximum(s - 1.0, 0.0))
+
+
+def normalize_sharpness(s):
+    """Map user sharpness to the internal form: ≥ 10 → inf, ≤ 0 → 0."""
+    s = np.asarray(s, dtype=np.float64)
+    return np.where(s >= INFINITE_SHARPNESS, np.inf, np.maximum(s, 0.0))
+
