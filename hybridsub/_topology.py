@@ -210,10 +210,10 @@ def child_faces(level: Level, plan: StepPlan):
 def child_creases(level: Level, plan: StepPlan, tagged: np.ndarray):
     """Tagged creases of the next level: children (u, m), (m, w) with sharpness s − 1.
 
-    ``tagged`` (ne,) is the user-tagged sharpness per edge (boundary edges are creases
-    implicitly and are not carried as tags).
+    ``tagged`` (ne,) is the user-tagged sharpness per edge. Boundary edges are creases
+    implicitly: a tag on one is not carried on.
     """
-    keep = np.flatnonzero((tagged > 1) & (plan.kind == R.EDGE_SPLIT))
+    keep = np.flatnonzero((tagged > 1) & (plan.kind == R.EDGE_SPLIT) & ~level.boundary_edge)
     ev = level.edge_vertices[keep]
     mid = plan.edge_point[keep]
     pairs = np.empty((2 * len(keep), 2), np.int64)
