@@ -13,7 +13,11 @@ True
 
 from ._errors import MeshError
 from ._examples import load_example
+from ._features import Features, detect_features
 from ._refine import Refinement, RefinementStep, refine, subdivide
 
-__all__ = ["subdivide", "refine", "Refinement", "RefinementStep", "MeshError", "load_example"]
+__all__ = [
+    "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
+    "load_example",
+]
 __version__ = "0.1.0"
