@@ -488,11 +488,14 @@ def meshes(kind="any", *, bowties=True, shuffle=True, max_points=100):
 
 def random_sharpness(rng, k, kind="mixed"):
     """``kind``: "inf" (all inf), "mixed" (inf, (0,1), (1,3), >= 10, and exact 1 and 2),
-    "finite" (no inf, no >= 10), "semisharp" ((0, 1) and (1, 3) only)."""
+    "finite" (no inf, no >= 10), "semisharp" ((0, 1) and (1, 3) only), "mixed0" (as
+    "mixed", plus 0 and negative values, which mean "no crease")."""
     if kind == "inf":
         return np.full(k, np.inf)
     if kind == "mixed":
         cat = rng.integers(0, 6, size=k)
+    elif kind == "mixed0":
+        cat = rng.integers(0, 8, size=k)
     elif kind == "finite":
         cat = rng.choice([1, 2, 4, 5], size=k)
     elif kind == "semisharp":
@@ -506,6 +509,8 @@ def random_sharpness(rng, k, kind="mixed"):
     s[cat == 3] = rng.uniform(10.0, 50.0, size=(cat == 3).sum())
     s[cat == 4] = 1.0
     s[cat == 5] = 2.0
+    s[cat == 6] = 0.0
+    s[cat == 7] = -rng.uniform(0.1, 2.0, size=(cat == 7).sum())
     return s
 
 
