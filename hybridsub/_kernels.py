@@ -1,8 +1,19 @@
-"""Numba kernels: the hot loops of the topology pass, the stencil rows and face emission.
+"""Numba kernels: the per-element loops of topology, classification, stencils and emission.
 
-Private. Every kernel takes contiguous int64/float64/int8/bool arrays and plain ints, and
-returns arrays; no Python objects. Callers in ``_topology`` and ``_stencils`` validate and
-convert. Halfedge ``h = 3 f + i`` of face ``f = (a, b, c)`` runs ``F[f, i] → F[f, (i+1) % 3]``.
+Private. Every kernel takes contiguous arrays (int64 indices, float64 data, int8 codes,
+bool masks) and plain scalars and returns arrays; no Python objects. Callers in
+``_topology`` and ``_stencils`` validate and convert.
+
+Halfedge ``h = 3 f + i`` of face ``f`` runs ``F[f, i] → F[f, (i+1) % 3]``; ``twin[h]`` is the
+halfedge across (−1 on the boundary). An edge is *owned* by its lower-numbered halfedge, and
+edges are numbered in owner order: the order of first appearance over the halfedges.
+
+One step runs ``classify_step`` (edge kinds, new-point layout, vertex statistics), then
+``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``), then either
+``apply_step`` (positions directly) or ``build_matrix`` (the CSR matrix S) — both walk the
+same rows in the same order, so ``apply_step(X) == S @ X`` bit for bit — and
+``emit_children`` (the next level's faces, twins and tags, derived from this level's
+instead of re-derived).
 """
 
 from __future__ import annotations
@@ -12,13 +23,19 @@ from numba import njit
 
 from ._rules import (
     CORNER,
-    CREASE,
     EDGE_FLIP,
     EDGE_KEEP,
     EDGE_SPLIT,
     EDGE_TRISECT,
     KOBBELT_TRISECTION,
+    REGION_LOOP,
+    REGION_MIXED,
+    REGION_SQRT3,
+    SCHEME_SQRT3,
     SMOOTH,
+    edge_weights,
+    vertex_mask,
+    vertex_rule,
 )
 
 # Error codes of halfedge_twins.
@@ -27,6 +44,7 @@ ERR_SAME_DIRECTION = 1  # two halfedges u→w: non-manifold edge or inconsistent
 ERR_MULTIPLE_TWINS = 2  # several halfedges w→u for one u→w
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
+_THIRD = 1.0 / 3.0
 
 
 @njit(cache=True, inline="always")
@@ -40,6 +58,11 @@ def _origin(F, h):
 
 
 @njit(cache=True, inline="always")
+def _opposite(F, h):
+    return F[h // 3, (h % 3 + 2) % 3]
+
+
+@njit(cache=True, inline="always")
 def _next(h):
     return h - h % 3 + (h % 3 + 1) % 3
 
@@ -47,6 +70,10 @@ def _next(h):
 @njit(cache=True, inline="always")
 def _prev(h):
     return h - h % 3 + (h % 3 + 2) % 3
+
+
+# ---------------------------------------------------------------------------------------
+# Topology of an input mesh (level 0). Later levels get their twins from emit_children.
 
 
 @njit(cache=True)
@@ -79,21 +106,48 @@ def halfedge_twins(F, n_vertices):
             g = by_origin[k]
             if g != h and _dest(F, g) == w:
                 return twin, by_origin, start, ERR_SAME_DIRECTION, h
+        if twin[h] >= 0:
+            continue
         for k in range(start[w], start[w + 1]):
             g = by_origin[k]
             if _dest(F, g) == u:
                 if twin[h] >= 0:
                     return twin, by_origin, start, ERR_MULTIPLE_TWINS, h
                 twin[h] = g
+        if twin[h] >= 0:
+            twin[twin[h]] = h
     return twin, by_origin, start, OK, -1
 
 
 @njit(cache=True)
-def number_edges(twin):
-    """Edges in order of first appearance over the halfedges.
+def find_halfedges(pairs, F, by_origin, origin_start):
+    """A halfedge of each vertex pair's edge (either orientation), −1 where there is none."""
+    k = pairs.shape[0]
+    out = np.full(k, -1, np.int64)
+    nv = origin_start.shape[0] - 1
+    for j in range(k):
+        a = pairs[j, 0]
+        b = pairs[j, 1]
+        if a < 0 or b < 0 or a >= nv or b >= nv:
+            continue
+        for q in range(origin_start[a], origin_start[a + 1]):
+            h = by_origin[q]
+            if _dest(F, h) == b:
+                out[j] = h
+                break
+        if out[j] >= 0:
+            continue
+        for q in range(origin_start[b], origin_start[b + 1]):
+            h = by_origin[q]
+            if _dest(F, h) == a:
+                out[j] = h
+                break
+    return out
 
-    Returns (edge_of_halfedge, owner): ``owner[e]`` is the lower-numbered halfedge of e.
-    """
+
+@njit(cache=True)
+def number_edges(twin):
+    """Edge of each halfedge and owner halfedge of each edge, edges in owner order."""
     nh = twin.shape[0]
     edge_of = np.empty(nh, np.int64)
     owner = np.empty(nh, np.int64)
@@ -134,32 +188,6 @@ def vertex_edges(F, owner, n_vertices):
 
 
 @njit(cache=True)
-def find_edges(pairs, F, by_origin, origin_start, edge_of):
-    """Edge index of each vertex pair (either orientation), −1 where there is no such edge."""
-    k = pairs.shape[0]
-    out = np.full(k, -1, np.int64)
-    nv = origin_start.shape[0] - 1
-    for j in range(k):
-        a = pairs[j, 0]
-        b = pairs[j, 1]
-        if a < 0 or b < 0 or a >= nv or b >= nv:
-            continue
-        for q in range(origin_start[a], origin_start[a + 1]):
-            h = by_origin[q]
-            if _dest(F, h) == b:
-                out[j] = edge_of[h]
-                break
-        if out[j] >= 0:
-            continue
-        for q in range(origin_start[b], origin_start[b + 1]):
-            h = by_origin[q]
-            if _dest(F, h) == a:
-                out[j] = edge_of[h]
-                break
-    return out
-
-
-@njit(cache=True)
 def boundary_links(F, twin):
     """For each boundary halfedge, the next and previous boundary halfedges (−1 elsewhere).
 
@@ -184,310 +212,507 @@ def boundary_links(F, twin):
 
 
 # ---------------------------------------------------------------------------------------
-# Stencil rows. Each row-writer takes scratch arrays ``cols``/``vals`` and returns how many
-# entries it wrote, columns sorted ascending and unique; the CSR builder calls it twice
-# (count, then fill) so rows are produced by one piece of code.
+# Classification of one step.
 
 
 @njit(cache=True, inline="always")
-def _sort_merge(cols, vals, k):
-    for i in range(1, k):
-        c = cols[i]
-        x = vals[i]
-        j = i - 1
-        while j >= 0 and cols[j] > c:
-            cols[j + 1] = cols[j]
-            vals[j + 1] = vals[j]
-            j -= 1
-        cols[j + 1] = c
-        vals[j + 1] = x
-    out = 0
-    for i in range(k):
-        if out > 0 and cols[out - 1] == cols[i]:
-            vals[out - 1] += vals[i]
+def _sharpness(h, twin, hsharp, has_tags):
+    """Sharpness of h's edge this step: inf on the boundary, the tag inside (0 untagged)."""
+    if twin[h] < 0:
+        return np.inf
+    if has_tags:
+        return hsharp[h]
+    return 0.0
+
+
+@njit(cache=True)
+def classify_step(F, twin, hsharp, has_tags, face_sharp, n_vertices, scheme, odd):
+    """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
+
+    Returns (hkind, edge_point, face_point, n_new, valence, c_parent, c_child, n_frac,
+    s_frac, n_faces, n_sharp). ``edge_point[h]`` is the index of the (first) point on h's
+    edge or −1; ``face_point[f]`` likewise. ``c_parent``/``c_child`` count incident edges
+    with s > 0 / s > 1; ``n_frac``/``s_frac`` count and sum s over edges with 0 < s ≤ 1;
+    ``n_faces``/``n_sharp`` count incident face corners and sharp ones.
+    """
+    m = F.shape[0]
+    nh = 3 * m
+    n = n_vertices
+    sqrt3 = scheme == SCHEME_SQRT3
+    hkind = np.empty(nh, np.int8)
+    edge_point = np.empty(nh, np.int64)
+    valence = np.zeros(n, np.int64)
+    c_parent = np.zeros(n, np.int64)
+    c_child = np.zeros(n, np.int64)
+    n_frac = np.zeros(n, np.int64)
+    s_frac = np.zeros(n, np.float64)
+    nxt = n
+    for h in range(nh):
+        t = twin[h]
+        if t >= 0 and t < h:
+            hkind[h] = hkind[t]
+            edge_point[h] = edge_point[t]
+            continue
+        s = _sharpness(h, twin, hsharp, has_tags)
+        if sqrt3:
+            if t < 0:
+                k = EDGE_KEEP if odd else EDGE_TRISECT
+            else:
+                k = EDGE_FLIP
+        elif s > 0.0 or face_sharp[h // 3] or (t >= 0 and face_sharp[t // 3]):
+            k = EDGE_SPLIT
         else:
-            cols[out] = cols[i]
-            vals[out] = vals[i]
-            out += 1
+            k = EDGE_FLIP
+        hkind[h] = k
+        if k == EDGE_SPLIT:
+            edge_point[h] = nxt
+            nxt += 1
+        elif k == EDGE_TRISECT:
+            edge_point[h] = nxt
+            nxt += 2
+        else:
+            edge_point[h] = -1
+        u = _origin(F, h)
+        w = _dest(F, h)
+        valence[u] += 1
+        valence[w] += 1
+        if s > 0.0:
+            c_parent[u] += 1
+            c_parent[w] += 1
+            if s > 1.0:
+                c_child[u] += 1
+                c_child[w] += 1
+            else:
+                n_frac[u] += 1
+                n_frac[w] += 1
+                s_frac[u] += s
+                s_frac[w] += s
+    face_point = np.empty(m, np.int64)
+    n_faces = np.zeros(n, np.int64)
+    n_sharp = np.zeros(n, np.int64)
+    for f in range(m):
+        if sqrt3:
+            has = odd or (twin[3 * f] >= 0 and twin[3 * f + 1] >= 0 and twin[3 * f + 2] >= 0)
+        else:
+            has = not face_sharp[f]
+        if has:
+            face_point[f] = nxt
+            nxt += 1
+        else:
+            face_point[f] = -1
+        sh = 1 if face_sharp[f] else 0
+        for i in range(3):
+            v = F[f, i]
+            n_faces[v] += 1
+            n_sharp[v] += sh
+    return hkind, edge_point, face_point, nxt, valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp
+
+
+@njit(cache=True)
+def vertex_coefficients(valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp, corner,
+                        weight_table, cs, cn, fix_boundary):
+    """Each vertex mask as (self, every neighbour, parent-crease neighbours, child-crease
+    neighbours) coefficients; ``fix_boundary`` pins every non-smooth vertex (Kobbelt's odd
+    steps)."""
+    n = valence.shape[0]
+    ca = np.empty(n, np.float64)
+    cb = np.empty(n, np.float64)
+    cp = np.empty(n, np.float64)
+    cc = np.empty(n, np.float64)
+    for v in range(n):
+        rp = vertex_rule(c_parent[v], corner[v])
+        rc = vertex_rule(c_child[v], corner[v])
+        if fix_boundary and rp != SMOOTH:
+            rp = CORNER
+            rc = CORNER
+        if n_sharp[v] == 0:
+            region = REGION_SQRT3
+        elif n_sharp[v] == n_faces[v]:
+            region = REGION_LOOP
+        else:
+            region = REGION_MIXED
+        blend = s_frac[v] / n_frac[v] if n_frac[v] > 0 else 0.0
+        ca[v], cb[v], cp[v], cc[v] = vertex_mask(valence[v], rp, rc, blend, weight_table[region, valence[v]],
+                                                 cs, cn)
+    return ca, cb, cp, cc
+
+
+# ---------------------------------------------------------------------------------------
+# Stencils. Rows: each old vertex (itself, then its neighbours in edge order), then the
+# edge points in edge order, then the face points. apply_step and build_matrix walk them
+# identically.
+
+
+@njit(cache=True, inline="always")
+def _neighbour_coefficient(v, s, cb, cp, cc):
+    c = cb[v]
+    if s > 0.0:
+        c += cp[v]
+        if s > 1.0:
+            c += cc[v]
+    return c
+
+
+@njit(cache=True)
+def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, cb, cp, cc,
+               bnext, bprev, n_new):
+    """The next level's data ``S @ X`` without forming S; X is (n, k) float64."""
+    n = ca.shape[0]
+    k = X.shape[1]
+    m = F.shape[0]
+    out = np.zeros((n_new, k), np.float64)
+    for v in range(n):
+        for j in range(k):
+            out[v, j] = ca[v] * X[v, j]
+    for h in range(3 * m):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = _origin(F, h)
+        w = _dest(F, h)
+        s = _sharpness(h, twin, hsharp, has_tags)
+        c = _neighbour_coefficient(u, s, cb, cp, cc)
+        if c != 0.0:
+            for j in range(k):
+                out[u, j] += c * X[w, j]
+        c = _neighbour_coefficient(w, s, cb, cp, cc)
+        if c != 0.0:
+            for j in range(k):
+                out[w, j] += c * X[u, j]
+        r = edge_point[h]
+        if r < 0:
+            continue
+        if hkind[h] == EDGE_TRISECT:
+            p0 = _origin(F, bprev[h])
+            p3 = _dest(F, bnext[h])
+            for j in range(k):
+                out[r, j] = _T0 * X[p0, j] + _T1 * X[u, j] + _T2 * X[w, j]
+                out[r + 1, j] = _T2 * X[u, j] + _T1 * X[w, j] + _T0 * X[p3, j]
+            continue
+        wab, wcd = edge_weights(s)
+        if wcd == 0.0:
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j]
+        else:
+            a = _opposite(F, h)
+            b = _opposite(F, t)
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j] + wcd * X[a, j] + wcd * X[b, j]
+    for f in range(m):
+        r = face_point[f]
+        if r >= 0:
+            a = F[f, 0]
+            b = F[f, 1]
+            c3 = F[f, 2]
+            for j in range(k):
+                out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
     return out
 
 
 @njit(cache=True)
-def _add_mask(v, rule, crease_min, factor, F, owner, ve_start, ve_edges, esharp, wn, cs, cn, cols, vals):
-    """Add factor × (the mask of ``rule``) to the row of v held in cols/vals (slot 0 = v).
-
-    Slot 1 + j belongs to the j-th incident edge's other end. Crease neighbours are the
-    ends of incident edges whose sharpness exceeds ``crease_min``.
-    """
-    if rule == CORNER:
-        vals[0] += factor
-        return
-    lo = ve_start[v]
-    hi = ve_start[v + 1]
-    if rule == CREASE:
-        vals[0] += factor * cs
-        for j in range(hi - lo):
-            if esharp[ve_edges[lo + j]] > crease_min:
-                vals[1 + j] += factor * cn
-        return
-    n = hi - lo
-    vals[0] += factor * (1.0 - n * wn[v])
-    for j in range(n):
-        vals[1 + j] += factor * wn[v]
-
-
-@njit(cache=True)
-def _vertex_row(v, F, owner, ve_start, ve_edges, esharp, rule_parent, rule_child, blend, wn, cs, cn, cols, vals):
-    lo = ve_start[v]
-    n = ve_start[v + 1] - lo
-    cols[0] = v
-    vals[0] = 0.0
-    for j in range(n):
-        h = owner[ve_edges[lo + j]]
-        a = _origin(F, h)
-        cols[1 + j] = _dest(F, h) if a == v else a
-        vals[1 + j] = 0.0
-    rp = rule_parent[v]
-    rc = rule_child[v]
-    if rp == SMOOTH or rc == rp or blend[v] >= 1.0:
-        _add_mask(v, rp, 0.0, 1.0, F, owner, ve_start, ve_edges, esharp, wn, cs, cn, cols, vals)
-        uses_all = rp == SMOOTH
-        uses_creases = rp == CREASE
-        child_creases = False
-    else:
-        w = blend[v]
-        _add_mask(v, rp, 0.0, w, F, owner, ve_start, ve_edges, esharp, wn, cs, cn, cols, vals)
-        _add_mask(v, rc, 1.0, 1.0 - w, F, owner, ve_start, ve_edges, esharp, wn, cs, cn, cols, vals)
-        uses_all = rc == SMOOTH
-        uses_creases = rp == CREASE
-        child_creases = rc == CREASE
-    k = 1
-    for j in range(n):
-        s = esharp[ve_edges[lo + j]]
-        if uses_all or (uses_creases and s > 0.0) or (child_creases and s > 1.0):
-            cols[k] = cols[1 + j]
-            vals[k] = vals[1 + j]
-            k += 1
-    return _sort_merge(cols, vals, k)
-
-
-@njit(cache=True)
-def _edge_row(e, second, F, twin, owner, esharp, kind, bnext, bprev, cols, vals):
-    h = owner[e]
-    a = _origin(F, h)
-    b = _dest(F, h)
-    if kind[e] == EDGE_TRISECT:
-        if second:  # e2 = (10 p_i + 16 p_{i+1} + p_{i+2}) / 27
-            cols[0] = a
-            vals[0] = _T2
-            cols[1] = b
-            vals[1] = _T1
-            cols[2] = _dest(F, bnext[h])
-            vals[2] = _T0
-        else:  # e1 = (p_{i-1} + 16 p_i + 10 p_{i+1}) / 27
-            cols[0] = _origin(F, bprev[h])
-            vals[0] = _T0
-            cols[1] = a
-            vals[1] = _T1
-            cols[2] = b
-            vals[2] = _T2
-        return _sort_merge(cols, vals, 3)
-    s = esharp[e]
-    t = twin[h]
-    if s >= 1.0 or t < 0:
-        cols[0] = a
-        vals[0] = 0.5
-        cols[1] = b
-        vals[1] = 0.5
-        return _sort_merge(cols, vals, 2)
-    # R4 3/8 (a + b) + 1/8 (c + d), blended with the midpoint for 0 < s < 1.
-    c = F[h // 3, (h % 3 + 2) % 3]
-    d = F[t // 3, (t % 3 + 2) % 3]
-    wab = s * 0.5 + (1.0 - s) * 0.375
-    wcd = (1.0 - s) * 0.125
-    cols[0] = a
-    vals[0] = wab
-    cols[1] = b
-    vals[1] = wab
-    cols[2] = c
-    vals[2] = wcd
-    cols[3] = d
-    vals[3] = wcd
-    return _sort_merge(cols, vals, 4)
-
-
-@njit(cache=True)
-def _face_row(f, F, cols, vals):
-    for i in range(3):
-        cols[i] = F[f, i]
-        vals[i] = 1.0 / 3.0
-    return _sort_merge(cols, vals, 3)
-
-
-@njit(cache=True)
-def build_matrix(
-    n_vertices, n_new, F, twin, owner, ve_start, ve_edges, esharp, kind, edge_point, face_point,
-    bnext, bprev, rule_parent, rule_child, blend, wn, cs, cn,
-):
-    """The step's refinement matrix S as CSR arrays (indptr, indices, data).
-
-    Rows: old vertices, then edge points (``edge_point[e]``, two rows for trisected edges),
-    then face points (``face_point[f]``); −1 marks an edge or face without a point.
-    """
-    ne = owner.shape[0]
+def build_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, cb, cp, cc,
+                 bnext, bprev, n_new):
+    """The step's refinement matrix S as CSR arrays (indptr, indices, data)."""
+    n = ca.shape[0]
     m = F.shape[0]
-    maxval = 4
-    for v in range(n_vertices):
-        d = ve_start[v + 1] - ve_start[v]
-        if d + 1 > maxval:
-            maxval = d + 1
-    cols = np.empty(maxval, np.int64)
-    vals = np.empty(maxval, np.float64)
-    counts = np.zeros(n_new + 1, np.int64)
-    for v in range(n_vertices):
-        counts[v + 1] = _vertex_row(v, F, owner, ve_start, ve_edges, esharp, rule_parent, rule_child, blend,
-                                    wn, cs, cn, cols, vals)
-    for e in range(ne):
-        r = edge_point[e]
+    nh = 3 * m
+    size = np.zeros(n_new + 1, np.int64)
+    for v in range(n):
+        size[v + 1] = 1
+    for h in range(nh):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = _origin(F, h)
+        w = _dest(F, h)
+        s = _sharpness(h, twin, hsharp, has_tags)
+        if _neighbour_coefficient(u, s, cb, cp, cc) != 0.0:
+            size[u + 1] += 1
+        if _neighbour_coefficient(w, s, cb, cp, cc) != 0.0:
+            size[w + 1] += 1
+        r = edge_point[h]
         if r < 0:
             continue
-        counts[r + 1] = _edge_row(e, False, F, twin, owner, esharp, kind, bnext, bprev, cols, vals)
-        if kind[e] == EDGE_TRISECT:
-            counts[r + 2] = _edge_row(e, True, F, twin, owner, esharp, kind, bnext, bprev, cols, vals)
+        if hkind[h] == EDGE_TRISECT:
+            size[r + 1] = 3
+            size[r + 2] = 3
+        else:
+            size[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
     for f in range(m):
-        r = face_point[f]
-        if r >= 0:
-            counts[r + 1] = _face_row(f, F, cols, vals)
+        if face_point[f] >= 0:
+            size[face_point[f] + 1] = 3
     for r in range(n_new):
-        counts[r + 1] += counts[r]
-    indptr = counts
-    nnz = indptr[n_new]
-    indices = np.empty(nnz, np.int64)
-    data = np.empty(nnz, np.float64)
-    for v in range(n_vertices):
-        k = _vertex_row(v, F, owner, ve_start, ve_edges, esharp, rule_parent, rule_child, blend,
-                        wn, cs, cn, cols, vals)
-        p = indptr[v]
-        indices[p:p + k] = cols[:k]
-        data[p:p + k] = vals[:k]
-    for e in range(ne):
-        r = edge_point[e]
+        size[r + 1] += size[r]
+    indptr = size
+    indices = np.empty(indptr[n_new], np.int64)
+    data = np.empty(indptr[n_new], np.float64)
+    fill = indptr[:n].copy()
+    for v in range(n):
+        indices[fill[v]] = v
+        data[fill[v]] = ca[v]
+        fill[v] += 1
+    for h in range(nh):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = _origin(F, h)
+        w = _dest(F, h)
+        s = _sharpness(h, twin, hsharp, has_tags)
+        c = _neighbour_coefficient(u, s, cb, cp, cc)
+        if c != 0.0:
+            indices[fill[u]] = w
+            data[fill[u]] = c
+            fill[u] += 1
+        c = _neighbour_coefficient(w, s, cb, cp, cc)
+        if c != 0.0:
+            indices[fill[w]] = u
+            data[fill[w]] = c
+            fill[w] += 1
+        r = edge_point[h]
         if r < 0:
             continue
-        k = _edge_row(e, False, F, twin, owner, esharp, kind, bnext, bprev, cols, vals)
-        indices[indptr[r]:indptr[r] + k] = cols[:k]
-        data[indptr[r]:indptr[r] + k] = vals[:k]
-        if kind[e] == EDGE_TRISECT:
-            k = _edge_row(e, True, F, twin, owner, esharp, kind, bnext, bprev, cols, vals)
-            indices[indptr[r + 1]:indptr[r + 1] + k] = cols[:k]
-            data[indptr[r + 1]:indptr[r + 1] + k] = vals[:k]
+        q = indptr[r]
+        if hkind[h] == EDGE_TRISECT:
+            indices[q] = _origin(F, bprev[h])
+            indices[q + 1] = u
+            indices[q + 2] = w
+            indices[q + 3] = u
+            indices[q + 4] = w
+            indices[q + 5] = _dest(F, bnext[h])
+            data[q] = _T0
+            data[q + 1] = _T1
+            data[q + 2] = _T2
+            data[q + 3] = _T2
+            data[q + 4] = _T1
+            data[q + 5] = _T0
+            continue
+        wab, wcd = edge_weights(s)
+        indices[q] = u
+        indices[q + 1] = w
+        data[q] = wab
+        data[q + 1] = wab
+        if wcd != 0.0:
+            indices[q + 2] = _opposite(F, h)
+            indices[q + 3] = _opposite(F, t)
+            data[q + 2] = wcd
+            data[q + 3] = wcd
     for f in range(m):
         r = face_point[f]
         if r >= 0:
-            k = _face_row(f, F, cols, vals)
-            indices[indptr[r]:indptr[r] + k] = cols[:k]
-            data[indptr[r]:indptr[r] + k] = vals[:k]
+            q = indptr[r]
+            for i in range(3):
+                indices[q + i] = F[f, i]
+                data[q + i] = _THIRD
     return indptr, indices, data
 
 
 # ---------------------------------------------------------------------------------------
-# Connectivity of the next level.
-
-
-@njit(cache=True)
-def child_face_counts(F, edge_of, kind, face_sharp):
-    """Number of children of each face: 4 if sharp, else 3 + its split edges."""
-    m = F.shape[0]
-    out = np.empty(m, np.int64)
-    for f in range(m):
-        if face_sharp[f]:
-            out[f] = 4
-        else:
-            c = 3
-            for i in range(3):
-                if kind[edge_of[3 * f + i]] == EDGE_SPLIT:
-                    c += 1
-            out[f] = c
-    return out
+# The next level: faces in parent order, and their twins and tags derived from this level.
+#
+# A smooth face emits, per halfedge u→w, a split pair A = (c, u, m), B = (c, m, w), a flip
+# triangle T = (u, apex(g), apex(f)), a kept boundary triangle T = (c, u, w), or (Kobbelt's
+# even steps) the trisection triangle (e1, e2, x); ``first[h]`` is the index of the first
+# child face of h. A sharp face emits C0..C3 at ``first[3f]``. The child halfedges that the
+# twins are stated in:
+#   FH(h) = u→m, SH(h) = m→w (the two halves of a split edge);
+#   OUT(h) = c_f→u and IN(h) = w→c_f (the spokes to f's face point).
 
 
 @njit(cache=True, inline="always")
-def _apex(F, g, hg, edge_of, kind, edge_point, face_point):
-    """The new vertex a face contributes to the flipped edge across its halfedge hg."""
+def _first_half(h, face_sharp, first):
+    i = h % 3
+    if face_sharp[h // 3]:
+        return 3 * (first[h] + i) + i
+    return 3 * first[h] + 1
+
+
+@njit(cache=True, inline="always")
+def _second_half(h, face_sharp, first):
+    i = h % 3
+    if face_sharp[h // 3]:
+        return 3 * (first[h] + (i + 1) % 3) + i
+    return 3 * (first[h] + 1) + 1
+
+
+@njit(cache=True, inline="always")
+def _spoke_out(h, hkind, first):
+    if hkind[h] == EDGE_FLIP:
+        return 3 * first[h] + 2
+    return 3 * first[h]
+
+
+@njit(cache=True, inline="always")
+def _spoke_in(h, twin, hkind, first):
+    k = hkind[h]
+    if k == EDGE_FLIP:
+        return 3 * first[twin[h]]
+    if k == EDGE_SPLIT:
+        return 3 * (first[h] + 1) + 2
+    return 3 * first[h] + 2
+
+
+@njit(cache=True, inline="always")
+def _trisected_at(g, hkind):
+    """Local index of the trisected boundary halfedge of face g (−1 if none)."""
+    for j in range(3):
+        if hkind[3 * g + j] == EDGE_TRISECT:
+            return j
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _apex(g, hg, hkind, edge_point, face_point):
+    """The new vertex face g gives the flipped edge across its halfedge hg."""
     if face_point[g] >= 0:
         return face_point[g]
-    base = 3 * g
-    for j in range(3):  # g is trisected along its boundary halfedge base + j
-        e = edge_of[base + j]
-        if kind[e] == EDGE_TRISECT:
-            k = hg - base
-            if k == (j + 1) % 3:
-                return edge_point[e] + 1
-            return edge_point[e]
+    j = _trisected_at(g, hkind)
+    if hg == 3 * g + (j + 1) % 3:
+        return edge_point[3 * g + j] + 1
+    return edge_point[3 * g + j]
+
+
+@njit(cache=True, inline="always")
+def _flip_start_twin(t, hkind, face_point, first):
+    """Twin of the flip triangle's halfedge u→apex(g), g the face of t (t = w→u)."""
+    g = t // 3
+    if face_point[g] >= 0:
+        return _spoke_out(_next(t), hkind, first)
+    j = _trisected_at(g, hkind)
+    if t == 3 * g + (j + 1) % 3:
+        return 3 * first[3 * g + j] + 1
     return -1
 
 
 @njit(cache=True)
-def emit_faces(F, twin, edge_of, kind, edge_point, face_point, face_sharp, offsets):
-    """Faces of the next level, in parent order; ``offsets`` = prefix sums of the counts."""
+def child_offsets(hkind, face_sharp):
+    """First child face of every face (``offsets``, m + 1) and of every halfedge (``first``)."""
+    m = face_sharp.shape[0]
+    offsets = np.empty(m + 1, np.int64)
+    first = np.empty(3 * m, np.int64)
+    o = 0
+    for f in range(m):
+        offsets[f] = o
+        if face_sharp[f]:
+            for i in range(3):
+                first[3 * f + i] = o
+            o += 4
+        else:
+            for i in range(3):
+                first[3 * f + i] = o
+                o += 2 if hkind[3 * f + i] == EDGE_SPLIT else 1
+    offsets[m] = o
+    return offsets, first
+
+
+@njit(cache=True)
+def emit_children(F, twin, hsharp, has_tags, hkind, edge_point, face_point, face_sharp, offsets, first,
+                  want_topology):
+    """Faces of the next level; with ``want_topology`` also their twins, halfedge sharpness
+    (children of creases with s > 1 carry s − 1) and sharp-face mask."""
     m = F.shape[0]
     total = offsets[m]
     out = np.empty((total, 3), np.int64)
-    parent = np.empty(total, np.int64)
+    nt = 3 * total if want_topology else 0
+    tw = np.empty(nt, np.int64)
+    hs = np.zeros(nt if has_tags else 0, np.float64)
+    fs = np.zeros(total if want_topology else 0, np.bool_)
     for f in range(m):
         o = offsets[f]
-        for q in range(o, offsets[f + 1]):
-            parent[q] = f
-        a = F[f, 0]
-        b = F[f, 1]
-        c = F[f, 2]
         if face_sharp[f]:
-            mab = edge_point[edge_of[3 * f]]
-            mbc = edge_point[edge_of[3 * f + 1]]
-            mca = edge_point[edge_of[3 * f + 2]]
-            out[o, 0] = a
-            out[o, 1] = mab
-            out[o, 2] = mca
-            out[o + 1, 0] = mab
-            out[o + 1, 1] = b
-            out[o + 1, 2] = mbc
-            out[o + 2, 0] = mca
-            out[o + 2, 1] = mbc
-            out[o + 2, 2] = c
-            out[o + 3, 0] = mab
-            out[o + 3, 1] = mbc
-            out[o + 3, 2] = mca
+            m0 = edge_point[3 * f]
+            m1 = edge_point[3 * f + 1]
+            m2 = edge_point[3 * f + 2]
+            out[o, 0] = F[f, 0]
+            out[o, 1] = m0
+            out[o, 2] = m2
+            out[o + 1, 0] = m0
+            out[o + 1, 1] = F[f, 1]
+            out[o + 1, 2] = m1
+            out[o + 2, 0] = m2
+            out[o + 2, 1] = m1
+            out[o + 2, 2] = F[f, 2]
+            out[o + 3, 0] = m0
+            out[o + 3, 1] = m1
+            out[o + 3, 2] = m2
+            if want_topology:
+                for q in range(4):
+                    fs[o + q] = True
+                c3 = 3 * (o + 3)
+                tw[3 * o + 1] = c3 + 2
+                tw[3 * (o + 1) + 2] = c3
+                tw[3 * (o + 2)] = c3 + 1
+                tw[c3] = 3 * (o + 1) + 2
+                tw[c3 + 1] = 3 * (o + 2)
+                tw[c3 + 2] = 3 * o + 1
+                for i in range(3):
+                    h = 3 * f + i
+                    t = twin[h]
+                    a = _first_half(h, face_sharp, first)
+                    b = _second_half(h, face_sharp, first)
+                    tw[a] = _second_half(t, face_sharp, first) if t >= 0 else -1
+                    tw[b] = _first_half(t, face_sharp, first) if t >= 0 else -1
+                    if has_tags and t >= 0 and hsharp[h] > 1.0:
+                        s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
+                        hs[a] = s
+                        hs[b] = s
             continue
         cf = face_point[f]
         for i in range(3):
             h = 3 * f + i
             u = F[f, i]
             w = F[f, (i + 1) % 3]
-            e = edge_of[h]
-            k = kind[e]
+            k = hkind[h]
+            q = first[h]
+            t = twin[h]
             if k == EDGE_SPLIT:
-                mid = edge_point[e]
-                out[o, 0] = cf
-                out[o, 1] = u
-                out[o, 2] = mid
-                out[o + 1, 0] = cf
-                out[o + 1, 1] = mid
-                out[o + 1, 2] = w
-                o += 2
+                mid = edge_point[h]
+                out[q, 0] = cf
+                out[q, 1] = u
+                out[q, 2] = mid
+                out[q + 1, 0] = cf
+                out[q + 1, 1] = mid
+                out[q + 1, 2] = w
+                if want_topology:
+                    tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                    tw[3 * q + 1] = _second_half(t, face_sharp, first) if t >= 0 else -1
+                    tw[3 * q + 2] = 3 * (q + 1)
+                    tw[3 * (q + 1)] = 3 * q + 2
+                    tw[3 * (q + 1) + 1] = _first_half(t, face_sharp, first) if t >= 0 else -1
+                    tw[3 * (q + 1) + 2] = _spoke_out(_next(h), hkind, first)
+                    if has_tags and t >= 0 and hsharp[h] > 1.0:
+                        s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
+                        hs[3 * q + 1] = s
+                        hs[3 * (q + 1) + 1] = s
             elif k == EDGE_KEEP:
-                out[o, 0] = cf
-                out[o, 1] = u
-                out[o, 2] = w
-                o += 1
+                out[q, 0] = cf
+                out[q, 1] = u
+                out[q, 2] = w
+                if want_topology:
+                    tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                    tw[3 * q + 1] = -1
+                    tw[3 * q + 2] = _spoke_out(_next(h), hkind, first)
             elif k == EDGE_TRISECT:
-                out[o, 0] = edge_point[e]
-                out[o, 1] = edge_point[e] + 1
-                out[o, 2] = F[f, (i + 2) % 3]
-                o += 1
+                x = F[f, (i + 2) % 3]
+                out[q, 0] = edge_point[h]
+                out[q, 1] = edge_point[h] + 1
+                out[q, 2] = x
+                if want_topology:
+                    tw[3 * q] = -1
+                    tw[3 * q + 1] = 3 * first[twin[_next(h)]]
+                    tw[3 * q + 2] = 3 * first[_prev(h)] + 2
             else:  # EDGE_FLIP
-                t = twin[h]
-                out[o, 0] = u
-                out[o, 1] = _apex(F, t // 3, t, edge_of, kind, edge_point, face_point)
-                out[o, 2] = _apex(F, f, h, edge_of, kind, edge_point, face_point)
-                o += 1
-    return out, parent
+                out[q, 0] = u
+                out[q, 1] = _apex(t // 3, t, hkind, edge_point, face_point)
+                out[q, 2] = _apex(f, h, hkind, edge_point, face_point)
+                if want_topology:
+                    tw[3 * q] = _flip_start_twin(t, hkind, face_point, first)
+                    tw[3 * q + 1] = 3 * first[t] + 1
+                    if cf >= 0:
+                        tw[3 * q + 2] = _spoke_in(_prev(h), twin, hkind, first)
+                    else:  # f trisected along its halfedge j: h is its second or third halfedge
+                        j = _trisected_at(f, hkind)
+                        if i == (j + 1) % 3:
+                            tw[3 * q + 2] = -1
+                        else:
+                            tw[3 * q + 2] = 3 * first[3 * f + j] + 2
+    return out, tw, hs, fs

@@ -14,8 +14,8 @@ import scipy.sparse as sp
 
 from . import _validate as val
 from ._errors import MeshError
-from ._stencils import step_matrix
-from ._topology import build_level, child_creases, child_faces, plan_step
+from ._stencils import apply_step, step_matrix
+from ._topology import build_level, child_creases, child_level, face_parents, plan_step
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,11 +167,36 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
     >>> r.faces.shape, r.matrix.shape
     ((36, 3), (20, 4))
     """
+    levels, Fi, n, pairs, sharp, face_sharp, faces_as_indices, corner = _prepare(
+        F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+
+    def faces_out(mask):
+        return np.flatnonzero(mask) if faces_as_indices else mask
+
+    corners_out = np.flatnonzero(corner)
+    steps = []
+    face_parent = np.arange(len(Fi), dtype=np.int64)
+    if len(Fi) == 0:  # nothing to refine: every level is the input
+        steps = [RefinementStep(Fi.copy(), sp.identity(n, format="csr"), pairs, sharp, faces_out(face_sharp),
+                                corners_out, face_parent) for _ in range(levels)]
+    for level, plan, faces, child, offsets in _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner,
+                                                    loop_weights, topology_last=True):
+        pairs, sharp = child_creases(level, plan)
+        parent = face_parents(offsets)
+        face_parent = face_parent[parent]
+        steps.append(RefinementStep(faces, step_matrix(level, plan), pairs, sharp, faces_out(child.face_sharp),
+                                    corners_out, parent))
+    last = steps[-1] if steps else None
+    return Refinement(last.faces if last else Fi.copy(), pairs, sharp,
+                      last.sharp_faces if last else faces_out(face_sharp), corners_out, face_parent, steps, n)
+
+
+def _prepare(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights):
+    """Validate and normalise refine's arguments."""
     levels = val.check_options(scheme, levels, loop_weights)
     Fi, n = val.as_faces(F, n_vertices)
-    m = len(Fi)
     pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
-    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, m)
+    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
     corner = val.as_corner_mask(corners, n)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(
@@ -181,41 +206,24 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
     if scheme == "loop":
         face_sharp[:] = True
     keep = sharp > 0
-    pairs, sharp = pairs[keep], sharp[keep]
+    return levels, Fi, n, pairs[keep], sharp[keep], face_sharp, faces_as_indices, corner
 
-    def faces_out(mask):
-        return np.flatnonzero(mask) if faces_as_indices else mask
 
-    corners_out = np.flatnonzero(corner)
-    steps = []
-    face_parent = np.arange(m, dtype=np.int64)
-    faces = Fi
-    if levels > 0 and m:
-        level = build_level(Fi, n)
-        for step in range(1, levels + 1):
-            tagged = np.zeros(level.n_edges)
-            if len(pairs):
-                eid = level.find_edges(pairs)
-                if step == 1 and (eid < 0).any():
-                    j = int(np.flatnonzero(eid < 0)[0])
-                    raise MeshError(f"sharp edge {j} = {pairs[j].tolist()} is not an edge of the mesh")
-                np.maximum.at(tagged, eid, sharp)
-            plan = plan_step(level, tagged, face_sharp, corner, scheme, step, loop_weights)
-            S = step_matrix(level, plan)
-            faces, parent = child_faces(level, plan)
-            pairs, sharp = child_creases(level, plan, tagged)
-            face_sharp = plan.face_sharp[parent]
-            corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
-            face_parent = face_parent[parent]
-            steps.append(RefinementStep(faces, S, pairs, sharp, faces_out(face_sharp), corners_out, parent))
-            if step < levels:
-                level = build_level(faces, plan.n_new)
-    elif levels > 0:  # no faces: nothing to refine, every level is the input
-        for _ in range(levels):
-            steps.append(RefinementStep(Fi.copy(), sp.identity(n, format="csr"), pairs, sharp,
-                                        faces_out(face_sharp), corners_out, np.arange(m, dtype=np.int64)))
-    return Refinement(faces if steps else Fi.copy(), pairs, sharp, faces_out(face_sharp), corners_out,
-                      face_parent, steps, n)
+def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last):
+    """Run the steps; yield (level, plan, child faces, child level, child offsets) for each.
+
+    The child level of the last step (its twins and tags) is built only if
+    ``topology_last``.
+    """
+    if levels == 0 or len(Fi) == 0:
+        return
+    level = build_level(Fi, n).tag(pairs, sharp, face_sharp)
+    for step in range(1, levels + 1):
+        plan = plan_step(level, corner, scheme, step, loop_weights)
+        faces, child, offsets = child_level(level, plan, want_topology=topology_last or step < levels)
+        yield level, plan, faces, child, offsets
+        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
+        level = child
 
 
 def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
@@ -270,10 +278,17 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
     """
     A = np.asarray(V)
     Vf = val.as_vertices(A)
-    r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
-               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
-    V2 = r.apply(Vf).astype(out_dtype, copy=False)
     if return_matrix:
-        return V2, r.faces, r.matrix
-    return V2, r.faces
+        r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
+                   sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+        return r.apply(Vf).astype(out_dtype, copy=False), r.faces, r.matrix
+    levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
+        F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
+    X, faces = Vf, Fi
+    for level, plan, faces, _, _ in _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights,
+                                          topology_last=False):
+        X = apply_step(level, plan, X)
+    if X is Vf:
+        X, faces = Vf.copy(), Fi.copy()
+    return X.astype(out_dtype, copy=False), faces

@@ -8,6 +8,7 @@ applies where; the matrix layer turns the weights into rows of S.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 # Vertex rules (OpenSubdiv's Sdc calls them the same). A dart (one crease edge) is SMOOTH.
 SMOOTH = 0
@@ -18,6 +19,10 @@ CORNER = 2
 REGION_SQRT3 = 0
 REGION_LOOP = 1
 REGION_MIXED = 2
+
+# Schemes, as the kernels see them.
+SCHEME_CODES = {"hybrid": 0, "sqrt3": 1, "loop": 2}
+SCHEME_HYBRID, SCHEME_SQRT3, SCHEME_LOOP = 0, 1, 2
 
 # Edge kinds of one step.
 EDGE_FLIP = 0  # sqrt3 edge flip: no point on it
@@ -109,10 +114,65 @@ def smooth_neighbour_weight(n, region, loop_weights="loop"):
     return np.where(n > 0, w, 0.0)
 
 
+def smooth_weight_table(max_valence, loop_weights="loop"):
+    """Per-neighbour smooth weights by region and valence: table[region, n], n = 0..max_valence.
+
+    Examples
+    --------
+    >>> t = smooth_weight_table(6)
+    >>> t.shape, float(t[REGION_LOOP, 6])
+    ((3, 7), 0.0625)
+    """
+    n = np.arange(max_valence + 1)
+    return np.stack([smooth_neighbour_weight(n, r, loop_weights)
+                     for r in (REGION_SQRT3, REGION_LOOP, REGION_MIXED)])
+
+
+@njit(cache=True)
 def vertex_rule(crease_count, is_corner):
     """Rule of a vertex from its number of incident creases and its corner tag."""
-    c = np.asarray(crease_count)
-    return np.where(is_corner | (c >= 3), CORNER, np.where(c == 2, CREASE, SMOOTH)).astype(np.int8)
+    if is_corner or crease_count >= 3:
+        return CORNER
+    if crease_count == 2:
+        return CREASE
+    return SMOOTH
+
+
+@njit(cache=True)
+def vertex_mask(n, rule_parent, rule_child, blend, smooth_w, cs, cn):
+    """A vertex point's mask as four coefficients: (self, every neighbour, each neighbour
+    along a crease of this level (s > 0), each neighbour along a crease of the next level
+    (s > 1)).
+
+    ``n`` is the valence, ``smooth_w`` the per-neighbour weight of the region's smooth mask,
+    ``(cs, cn)`` the crease mask. Where the parent and child rules differ (semi-sharp creases
+    decaying), the parent mask is blended with the child mask: ``blend · parent +
+    (1 − blend) · child`` (OpenSubdiv's fractional weight).
+    """
+    if rule_parent == SMOOTH:
+        return 1.0 - n * smooth_w, smooth_w, 0.0, 0.0
+    if rule_child == rule_parent or blend >= 1.0:
+        if rule_parent == CREASE:
+            return cs, 0.0, cn, 0.0
+        return 1.0, 0.0, 0.0, 0.0
+    w = blend
+    a = w * cs if rule_parent == CREASE else w
+    p = w * cn if rule_parent == CREASE else 0.0
+    if rule_child == CREASE:
+        return a + (1.0 - w) * cs, 0.0, p, (1.0 - w) * cn
+    return a + (1.0 - w) * (1.0 - n * smooth_w), (1.0 - w) * smooth_w, p, 0.0
+
+
+@njit(cache=True)
+def edge_weights(s):
+    """Edge point weights (each end, each opposite vertex) for an edge of sharpness s.
+
+    s ≥ 1 (or inf): the crease midpoint (B1); s = 0: Loop's R4 (3/8, 1/8); in between the
+    two blended, s · midpoint + (1 − s) · R4.
+    """
+    if s >= 1.0:
+        return 0.5, 0.0
+    return s * 0.5 + (1.0 - s) * 0.375, (1.0 - s) * 0.125
 
 
 def child_sharpness(s):

@@ -1,13 +1,17 @@
-"""Topology and tags of one level: halfedges, edges, incidences, and one step's classes.
+"""Topology and tags of one level, and one step's classes.
 
-This is the layer between the rules (``_rules``, pure weights) and the matrices
-(``_stencils``): it knows connectivity and tags, never positions, never weights beyond
-asking ``_rules`` for them by valence and region.
+This is the layer between the rules (``_rules``: weights from neighbourhood numbers) and
+the matrices (``_stencils``): it knows connectivity and tags, never positions. A
+:class:`Level` is a mesh's faces with its halfedge twins and tags; :func:`plan_step`
+classifies one step (edge kinds, vertex masks, the layout of the new points);
+:func:`child_level` builds the next level from the plan, deriving its twins and tags
+instead of searching for them again.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -16,31 +20,51 @@ from . import _rules as R
 from ._errors import MeshError
 
 
-@dataclass(frozen=True, eq=False)
 class Level:
-    """Connectivity of one level: faces plus the halfedge/edge tables derived from them."""
+    """Connectivity and tags of one level.
 
-    faces: np.ndarray  # (m, 3) int64
-    n_vertices: int
-    twin: np.ndarray  # (3m,) halfedge across, −1 on the boundary
-    by_origin: np.ndarray  # (3m,) halfedges grouped by origin vertex
-    origin_start: np.ndarray  # (n + 1,) CSR offsets into by_origin
-    edge_of: np.ndarray  # (3m,) edge of each halfedge
-    edge_owner: np.ndarray  # (ne,) lower-numbered halfedge of each edge
-    ve_start: np.ndarray  # (n + 1,) CSR offsets into ve_edges
-    ve_edges: np.ndarray  # (2 ne,) incident edges of each vertex
+    Attributes
+    ----------
+    faces : (m, 3) int64
+    n_vertices : int
+    twin : (3m,) int64
+        Halfedge across each halfedge ``3f + i`` (−1 on the boundary).
+    hsharp : (3m,) float64 or None
+        Tagged sharpness of each halfedge's edge (0 untagged, inf infinitely sharp); None
+        when nothing is tagged.
+    face_sharp : (m,) bool
+        Sharp faces (refined 1-to-4).
+    """
+
+    def __init__(self, faces, n_vertices, twin, hsharp=None, face_sharp=None, by_origin=None):
+        self.faces = faces
+        self.n_vertices = int(n_vertices)
+        self.twin = twin
+        self.hsharp = hsharp
+        self.face_sharp = np.zeros(len(faces), dtype=bool) if face_sharp is None else face_sharp
+        self._by_origin = by_origin
 
     @property
     def n_faces(self) -> int:
         return self.faces.shape[0]
 
+    @cached_property
+    def _edges(self):
+        return K.number_edges(self.twin)
+
+    @property
+    def edge_of(self) -> np.ndarray:
+        """(3m,) edge of each halfedge, edges numbered in order of first appearance."""
+        return self._edges[0]
+
+    @property
+    def edge_owner(self) -> np.ndarray:
+        """(ne,) lower-numbered halfedge of each edge."""
+        return self._edges[1]
+
     @property
     def n_edges(self) -> int:
         return self.edge_owner.shape[0]
-
-    @property
-    def valence(self) -> np.ndarray:
-        return np.diff(self.ve_start)
 
     @property
     def edge_vertices(self) -> np.ndarray:
@@ -53,14 +77,64 @@ class Level:
     def boundary_edge(self) -> np.ndarray:
         return self.twin[self.edge_owner] < 0
 
+    @cached_property
+    def _vertex_edges(self):
+        return K.vertex_edges(self.faces, self.edge_owner, self.n_vertices)
+
+    @property
+    def ve_start(self) -> np.ndarray:
+        """(n + 1,) CSR offsets of each vertex's incident edges in ``ve_edges``."""
+        return self._vertex_edges[0]
+
+    @property
+    def ve_edges(self) -> np.ndarray:
+        """Incident edges of each vertex, in increasing edge order."""
+        return self._vertex_edges[1]
+
+    @property
+    def valence(self) -> np.ndarray:
+        return np.diff(self.ve_start)
+
+    def find_halfedges(self, pairs: np.ndarray) -> np.ndarray:
+        """A halfedge of each vertex pair's edge, −1 where the mesh has no such edge."""
+        if self._by_origin is None:
+            self._by_origin = _group_by_origin(self.faces, self.n_vertices)
+        by_origin, origin_start = self._by_origin
+        pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
+        return K.find_halfedges(pairs, self.faces, by_origin, origin_start)
+
     def find_edges(self, pairs: np.ndarray) -> np.ndarray:
         """Edge index of each vertex pair, −1 where the mesh has no such edge."""
-        pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
-        return K.find_edges(pairs, self.faces, self.by_origin, self.origin_start, self.edge_of)
+        h = self.find_halfedges(pairs)
+        return np.where(h >= 0, self.edge_of[np.maximum(h, 0)], -1)
+
+    def tag(self, pairs: np.ndarray, sharpness: np.ndarray, face_sharp: np.ndarray) -> "Level":
+        """This level with creases (vertex pairs, sharpness > 0) and sharp faces tagged.
+
+        Raises MeshError naming the first pair that is not an edge; a pair listed twice keeps
+        its largest sharpness.
+        """
+        hsharp = None
+        if len(pairs):
+            h = self.find_halfedges(pairs)
+            if (h < 0).any():
+                j = int(np.flatnonzero(h < 0)[0])
+                raise MeshError(f"sharp edge {j} = {pairs[j].tolist()} is not an edge of the mesh")
+            hsharp = np.zeros(3 * self.n_faces)
+            np.maximum.at(hsharp, h, sharpness)
+            t = self.twin[h]
+            inner = t >= 0
+            np.maximum.at(hsharp, t[inner], sharpness[inner])
+        return Level(self.faces, self.n_vertices, self.twin, hsharp, face_sharp, self._by_origin)
+
+
+def _group_by_origin(F, n):
+    twin, by_origin, origin_start, err, h = K.halfedge_twins(F, n)
+    return by_origin, origin_start
 
 
 def build_level(faces: np.ndarray, n_vertices: int) -> Level:
-    """Build the halfedge tables of a mesh, or raise MeshError naming the offending edge.
+    """Build the halfedge twins of a mesh, or raise MeshError naming the offending edge.
 
     ``faces`` must already be an (m, 3) int64 array with indices in range and no repeated
     vertex within a face.
@@ -69,9 +143,7 @@ def build_level(faces: np.ndarray, n_vertices: int) -> Level:
     twin, by_origin, origin_start, err, h = K.halfedge_twins(F, n_vertices)
     if err != K.OK:
         raise _edge_error(F, int(h))
-    edge_of, owner = K.number_edges(twin)
-    ve_start, ve_edges = K.vertex_edges(F, owner, n_vertices)
-    return Level(F, int(n_vertices), twin, by_origin, origin_start, edge_of, owner, ve_start, ve_edges)
+    return Level(F, n_vertices, twin, by_origin=(by_origin, origin_start))
 
 
 def _edge_error(F: np.ndarray, h: int) -> MeshError:
@@ -94,131 +166,96 @@ def _edge_error(F: np.ndarray, h: int) -> MeshError:
 
 @dataclass(frozen=True, eq=False)
 class StepPlan:
-    """Everything one step decides from topology and tags, before any weight is written."""
+    """Everything one step decides from topology and tags, before any weight is applied."""
 
     scheme: str
     step: int  # 1-based within the call; only "sqrt3" cares (Kobbelt's odd/even boundary)
-    esharp: np.ndarray  # (ne,) sharpness this step: 0 smooth, > 0 crease, inf for boundary
-    kind: np.ndarray  # (ne,) int8 EDGE_* code
-    edge_point: np.ndarray  # (ne,) index of the (first) new point on the edge, −1 if none
+    hkind: np.ndarray  # (3m,) int8 EDGE_* code of each halfedge's edge
+    edge_point: np.ndarray  # (3m,) index of the (first) new point on each halfedge's edge, −1 if none
     face_point: np.ndarray  # (m,) index of the face point, −1 if none
-    face_sharp: np.ndarray  # (m,) bool
-    rule_parent: np.ndarray  # (n,) int8 vertex rule from edges with s > 0
-    rule_child: np.ndarray  # (n,) int8 vertex rule from edges with s > 1
-    blend: np.ndarray  # (n,) weight of the parent rule's mask where the two differ
-    smooth_weight: np.ndarray  # (n,) per-neighbour weight of the region's smooth mask
-    crease_mask: tuple  # (self, neighbour) weights of the crease vertex mask
+    coefficients: tuple  # (ca, cb, cp, cc), each (n,): every vertex mask, see _rules.vertex_mask
     n_new: int
     bnext: np.ndarray  # (3m,) boundary links, only filled for Kobbelt's even steps
     bprev: np.ndarray
 
 
-def plan_step(
-    level: Level,
-    edge_sharpness: np.ndarray,
-    face_sharp: np.ndarray,
-    corner: np.ndarray,
-    scheme: str,
-    step: int,
-    loop_weights: str,
-) -> StepPlan:
+def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_weights: str) -> StepPlan:
     """Classify edges and vertices of one step and lay out the new points.
 
-    ``edge_sharpness`` (ne,) holds the tagged sharpness per edge (0 = untagged), ``face_sharp``
-    (m,) the sharp-face mask, ``corner`` (n,) the corner mask.
+    Tags come from the level (``hsharp``, ``face_sharp``: all sharp for ``"loop"``, none for
+    ``"sqrt3"``); ``corner`` (n,) is the corner mask.
     """
-    n, m = level.n_vertices, level.n_faces
-    boundary = level.boundary_edge
-    ev = level.edge_vertices
-    owner = level.edge_owner
-    twin = level.twin
-    empty = np.empty(0, np.int64)
-    bnext = bprev = empty
-
-    if scheme == "sqrt3":
-        odd = step % 2 == 1
-        face_sharp = np.zeros(m, dtype=bool)
-        esharp = np.where(boundary, np.inf, 0.0)
-        kind = np.where(boundary, R.EDGE_KEEP if odd else R.EDGE_TRISECT, R.EDGE_FLIP).astype(np.int8)
-        crease_mask = R.KOBBELT_BOUNDARY_MASK
-        if odd:
-            has_fp = np.ones(m, dtype=bool)
-        else:
-            has_fp = ~(twin.reshape(m, 3) < 0).any(axis=1)
-            bnext, bprev = K.boundary_links(level.faces, twin)
+    F, twin = level.faces, level.twin
+    code = R.SCHEME_CODES[scheme]
+    odd = step % 2 == 1
+    sqrt3 = scheme == "sqrt3"
+    face_sharp = level.face_sharp
+    has_tags = level.hsharp is not None and not sqrt3
+    hsharp = level.hsharp if has_tags else _EMPTY_F
+    (hkind, edge_point, face_point, n_new, valence, c_parent, c_child, n_frac, s_frac, n_faces,
+     n_sharp) = K.classify_step(F, twin, hsharp, has_tags, face_sharp, level.n_vertices, code, odd)
+    table = R.smooth_weight_table(int(valence.max()) if len(valence) else 0, loop_weights)
+    cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
+    coefficients = K.vertex_coefficients(valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp, corner,
+                                         table, cs, cn, sqrt3 and odd)
+    if sqrt3 and not odd:
+        bnext, bprev = K.boundary_links(F, twin)
     else:
-        if scheme == "loop":
-            face_sharp = np.ones(m, dtype=bool)
-        esharp = np.where(boundary, np.inf, edge_sharpness)
-        f0 = owner // 3
-        t = twin[owner]
-        sharp_side = face_sharp[f0] | np.where(t >= 0, face_sharp[np.maximum(t, 0) // 3], False)
-        kind = np.where((esharp > 0) | sharp_side, R.EDGE_SPLIT, R.EDGE_FLIP).astype(np.int8)
-        crease_mask = R.CREASE_MASK
-        has_fp = ~face_sharp
-
-    # Vertex rules from incident crease counts (OpenSubdiv's parent and child rules).
-    ends = ev.ravel()
-    s2 = np.repeat(esharp, 2)
-    c_parent = np.bincount(ends, weights=s2 > 0, minlength=n)
-    c_child = np.bincount(ends, weights=s2 > 1, minlength=n)
-    rule_parent = R.vertex_rule(c_parent, corner)
-    rule_child = R.vertex_rule(c_child, corner)
-    if scheme == "sqrt3" and step % 2 == 1:
-        rule_parent = rule_child = np.where(rule_parent != R.SMOOTH, R.CORNER, R.SMOOTH).astype(np.int8)
-    fractional = (s2 > 0) & (s2 <= 1)
-    n_frac = np.bincount(ends, weights=fractional, minlength=n)
-    s_frac = np.bincount(ends, weights=np.where(fractional, s2, 0.0), minlength=n)
-    blend = np.divide(s_frac, n_frac, out=np.zeros(n), where=n_frac > 0)
-
-    # Region of each vertex: are its faces sharp (Loop), smooth (sqrt3) or both?
-    corners_of = level.faces.ravel()
-    n_faces_at = np.bincount(corners_of, minlength=n)
-    n_sharp_at = np.bincount(corners_of, weights=np.repeat(face_sharp, 3), minlength=n)
-    region = np.where(
-        n_sharp_at == 0, R.REGION_SQRT3, np.where(n_sharp_at == n_faces_at, R.REGION_LOOP, R.REGION_MIXED)
-    )
-    smooth_weight = R.smooth_neighbour_weight(level.valence, region, loop_weights)
-
-    # Layout: old vertices, edge points in edge order, face points in face order.
-    n_pts = (kind == R.EDGE_SPLIT).astype(np.int64) + 2 * (kind == R.EDGE_TRISECT)
-    first = n + np.cumsum(n_pts) - n_pts
-    edge_point = np.where(n_pts > 0, first, -1)
-    n_edge_pts = int(n_pts.sum())
-    face_point = np.where(has_fp, n + n_edge_pts + np.cumsum(has_fp) - 1, -1)
-    n_new = n + n_edge_pts + int(has_fp.sum())
-
-    return StepPlan(
-        scheme, step, esharp, kind, edge_point.astype(np.int64), face_point.astype(np.int64),
-        np.ascontiguousarray(face_sharp, dtype=bool), rule_parent, rule_child, blend,
-        np.ascontiguousarray(smooth_weight, dtype=np.float64), crease_mask, n_new, bnext, bprev,
-    )
+        bnext = bprev = _EMPTY_I
+    return StepPlan(scheme, step, hkind, edge_point, face_point, coefficients, int(n_new), bnext, bprev)
 
 
-def child_faces(level: Level, plan: StepPlan):
-    """Faces of the next level and the parent (in this level) of each."""
-    F = level.faces
-    counts = K.child_face_counts(F, level.edge_of, plan.kind, plan.face_sharp)
-    offsets = np.zeros(len(counts) + 1, np.int64)
-    np.cumsum(counts, out=offsets[1:])
-    faces, parent = K.emit_faces(
-        F, level.twin, level.edge_of, plan.kind, plan.edge_point, plan.face_point, plan.face_sharp, offsets
-    )
-    return faces, parent
+_EMPTY_F = np.empty(0, np.float64)
+_EMPTY_I = np.empty(0, np.int64)
 
 
-def child_creases(level: Level, plan: StepPlan, tagged: np.ndarray):
-    """Tagged creases of the next level: children (u, m), (m, w) with sharpness s − 1.
+def step_arguments(level: Level, plan: StepPlan) -> tuple:
+    """The arguments apply_step and build_matrix share, in their order (after the data)."""
+    has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
+    return (level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
+            plan.edge_point, plan.face_point, *plan.coefficients, plan.bnext, plan.bprev, plan.n_new)
 
-    ``tagged`` (ne,) is the user-tagged sharpness per edge. Boundary edges are creases
-    implicitly: a tag on one is not carried on.
+
+def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
+    """The next level (faces, twins, tags) and the parent face of each of its faces.
+
+    Without ``want_topology`` only the faces are built (for the last step of a call).
     """
-    keep = np.flatnonzero((tagged > 1) & (plan.kind == R.EDGE_SPLIT) & ~level.boundary_edge)
-    ev = level.edge_vertices[keep]
+    face_sharp = level.face_sharp
+    offsets, first = K.child_offsets(plan.hkind, face_sharp)
+    has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
+    faces, twin, hsharp, child_sharp = K.emit_children(
+        level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
+        plan.edge_point, plan.face_point, face_sharp, offsets, first, want_topology)
+    child = None
+    if want_topology:
+        child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
+    return faces, child, offsets
+
+
+def face_parents(offsets: np.ndarray) -> np.ndarray:
+    """Parent face of each child face, from the child offsets of the parents."""
+    return np.repeat(np.arange(len(offsets) - 1, dtype=np.int64), np.diff(offsets))
+
+
+def child_creases(level: Level, plan: StepPlan):
+    """Tagged creases of the next level as vertex pairs: children (u, m), (m, w) of each
+    tagged crease with s > 1, in edge order and the owner's orientation, with s − 1.
+
+    Boundary edges are creases implicitly: a tag on one is not carried on.
+    """
+    if level.hsharp is None or plan.scheme == "sqrt3":
+        return np.empty((0, 2), np.int64), np.empty(0)
+    owner = level.edge_owner
+    s = level.hsharp[owner]
+    keep = owner[(s > 1) & (level.twin[owner] >= 0) & (plan.hkind[owner] == R.EDGE_SPLIT)]
+    F = level.faces
+    f, i = keep // 3, keep % 3
+    u, w = F[f, i], F[f, (i + 1) % 3]
     mid = plan.edge_point[keep]
     pairs = np.empty((2 * len(keep), 2), np.int64)
-    pairs[0::2, 0] = ev[:, 0]
+    pairs[0::2, 0] = u
     pairs[0::2, 1] = mid
     pairs[1::2, 0] = mid
-    pairs[1::2, 1] = ev[:, 1]
-    return pairs, np.repeat(R.child_sharpness(tagged[keep]), 2)
+    pairs[1::2, 1] = w
+    return pairs, np.repeat(R.child_sharpness(level.hsharp[keep]), 2)
