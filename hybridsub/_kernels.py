@@ -1,8 +1,9 @@
 """Numba kernels: the per-element loops of topology, classification, stencils and emission.
 
 Private. Every kernel takes contiguous arrays (int64 indices, float64 data, int8 codes,
-bool masks) and plain scalars and returns arrays; no Python objects. Callers in
-``_topology`` and ``_stencils`` validate and convert.
+bool masks) and plain scalars; no Python objects. Large outputs are allocated by the
+callers in ``_topology`` and ``_stencils`` (NumPy backs big arrays with huge pages, which
+makes first touch several times cheaper than Numba's own allocations) and filled here.
 
 Halfedge ``h = 3 f + i`` of face ``f`` runs ``F[f, i] → F[f, (i+1) % 3]``; ``twin[h]`` is the
 halfedge across (−1 on the boundary). An edge is *owned* by its lower-numbered halfedge, and
@@ -10,9 +11,9 @@ edges are numbered in owner order: the order of first appearance over the halfed
 
 One step runs ``classify_step`` (edge kinds, new-point layout, vertex statistics), then
 ``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``), then either
-``apply_step`` (positions directly) or ``build_matrix`` (the CSR matrix S) — both walk the
-same rows in the same order, so ``apply_step(X) == S @ X`` bit for bit — and
-``emit_children`` (the next level's faces, twins and tags, derived from this level's
+``apply_step`` (positions directly) or ``matrix_row_sizes`` and ``fill_matrix`` (the CSR
+matrix S) — all walk the same rows in the same order, so ``apply_step(X) == S @ X`` bit for
+bit — and ``emit_children`` (the next level's faces, twins and tags, derived from this level's
 instead of re-derived).
 """
 
@@ -226,28 +227,21 @@ def _sharpness(h, twin, hsharp, has_tags):
 
 
 @njit(cache=True)
-def classify_step(F, twin, hsharp, has_tags, face_sharp, n_vertices, scheme, odd):
+def classify_step(F, twin, hsharp, has_tags, face_sharp, scheme, odd, hkind, edge_point, face_point,
+                  counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
 
-    Returns (hkind, edge_point, face_point, n_new, valence, c_parent, c_child, n_frac,
-    s_frac, n_faces, n_sharp). ``edge_point[h]`` is the index of the (first) point on h's
-    edge or −1; ``face_point[f]`` likewise. ``c_parent``/``c_child`` count incident edges
-    with s > 0 / s > 1; ``n_frac``/``s_frac`` count and sum s over edges with 0 < s ≤ 1;
-    ``n_faces``/``n_sharp`` count incident face corners and sharp ones.
+    Fills ``hkind`` and ``edge_point`` (3m,): each halfedge's edge kind and the index of the
+    (first) point on its edge or −1; ``face_point`` (m,) likewise. ``counts`` (6, n), zeroed
+    by the caller, receives per vertex: valence, incident edges with s > 0, with s > 1, with
+    0 < s ≤ 1, incident faces, incident sharp faces; ``s_frac`` (n,), zeroed, the sum of s
+    over edges with 0 < s ≤ 1. Returns the number of vertices of the next level.
     """
     m = F.shape[0]
-    nh = 3 * m
-    n = n_vertices
+    n = counts.shape[1]
     sqrt3 = scheme == SCHEME_SQRT3
-    hkind = np.empty(nh, np.int8)
-    edge_point = np.empty(nh, np.int64)
-    valence = np.zeros(n, np.int64)
-    c_parent = np.zeros(n, np.int64)
-    c_child = np.zeros(n, np.int64)
-    n_frac = np.zeros(n, np.int64)
-    s_frac = np.zeros(n, np.float64)
     nxt = n
-    for h in range(nh):
+    for h in range(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
             hkind[h] = hkind[t]
@@ -274,22 +268,19 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, n_vertices, scheme, odd
             edge_point[h] = -1
         u = _origin(F, h)
         w = _dest(F, h)
-        valence[u] += 1
-        valence[w] += 1
+        counts[0, u] += 1
+        counts[0, w] += 1
         if s > 0.0:
-            c_parent[u] += 1
-            c_parent[w] += 1
+            counts[1, u] += 1
+            counts[1, w] += 1
             if s > 1.0:
-                c_child[u] += 1
-                c_child[w] += 1
+                counts[2, u] += 1
+                counts[2, w] += 1
             else:
-                n_frac[u] += 1
-                n_frac[w] += 1
+                counts[3, u] += 1
+                counts[3, w] += 1
                 s_frac[u] += s
                 s_frac[w] += s
-    face_point = np.empty(m, np.int64)
-    n_faces = np.zeros(n, np.int64)
-    n_sharp = np.zeros(n, np.int64)
     for f in range(m):
         if sqrt3:
             has = odd or (twin[3 * f] >= 0 and twin[3 * f + 1] >= 0 and twin[3 * f + 2] >= 0)
@@ -303,38 +294,36 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, n_vertices, scheme, odd
         sh = 1 if face_sharp[f] else 0
         for i in range(3):
             v = F[f, i]
-            n_faces[v] += 1
-            n_sharp[v] += sh
-    return hkind, edge_point, face_point, nxt, valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp
+            counts[4, v] += 1
+            counts[5, v] += sh
+    return nxt
 
 
 @njit(cache=True)
-def vertex_coefficients(valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp, corner,
-                        weight_table, cs, cn, fix_boundary):
-    """Each vertex mask as (self, every neighbour, parent-crease neighbours, child-crease
-    neighbours) coefficients; ``fix_boundary`` pins every non-smooth vertex (Kobbelt's odd
-    steps)."""
-    n = valence.shape[0]
-    ca = np.empty(n, np.float64)
-    cb = np.empty(n, np.float64)
-    cp = np.empty(n, np.float64)
-    cc = np.empty(n, np.float64)
+def vertex_coefficients(counts, s_frac, corner, weight_table, cs, cn, fix_boundary, coefficients):
+    """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
+    parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
+    non-smooth vertex (Kobbelt's odd steps)."""
+    n = counts.shape[1]
     for v in range(n):
-        rp = vertex_rule(c_parent[v], corner[v])
-        rc = vertex_rule(c_child[v], corner[v])
+        rp = vertex_rule(counts[1, v], corner[v])
+        rc = vertex_rule(counts[2, v], corner[v])
         if fix_boundary and rp != SMOOTH:
             rp = CORNER
             rc = CORNER
-        if n_sharp[v] == 0:
+        if counts[5, v] == 0:
             region = REGION_SQRT3
-        elif n_sharp[v] == n_faces[v]:
+        elif counts[5, v] == counts[4, v]:
             region = REGION_LOOP
         else:
             region = REGION_MIXED
-        blend = s_frac[v] / n_frac[v] if n_frac[v] > 0 else 0.0
-        ca[v], cb[v], cp[v], cc[v] = vertex_mask(valence[v], rp, rc, blend, weight_table[region, valence[v]],
-                                                 cs, cn)
-    return ca, cb, cp, cc
+        blend = s_frac[v] / counts[3, v] if counts[3, v] > 0 else 0.0
+        val = counts[0, v]
+        a, b, p, c = vertex_mask(val, rp, rc, blend, weight_table[region, val], cs, cn)
+        coefficients[0, v] = a
+        coefficients[1, v] = b
+        coefficients[2, v] = p
+        coefficients[3, v] = c
 
 
 # ---------------------------------------------------------------------------------------
@@ -344,26 +333,24 @@ def vertex_coefficients(valence, c_parent, c_child, n_frac, s_frac, n_faces, n_s
 
 
 @njit(cache=True, inline="always")
-def _neighbour_coefficient(v, s, cb, cp, cc):
-    c = cb[v]
+def _neighbour_coefficient(v, s, coef):
+    c = coef[1, v]
     if s > 0.0:
-        c += cp[v]
+        c += coef[2, v]
         if s > 1.0:
-            c += cc[v]
+            c += coef[3, v]
     return c
 
 
 @njit(cache=True)
-def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, cb, cp, cc,
-               bnext, bprev, n_new):
-    """The next level's data ``S @ X`` without forming S; X is (n, k) float64."""
-    n = ca.shape[0]
+def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out):
+    """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S."""
+    n = coef.shape[1]
     k = X.shape[1]
     m = F.shape[0]
-    out = np.zeros((n_new, k), np.float64)
     for v in range(n):
         for j in range(k):
-            out[v, j] = ca[v] * X[v, j]
+            out[v, j] = coef[0, v] * X[v, j]
     for h in range(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
@@ -371,11 +358,11 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, 
         u = _origin(F, h)
         w = _dest(F, h)
         s = _sharpness(h, twin, hsharp, has_tags)
-        c = _neighbour_coefficient(u, s, cb, cp, cc)
+        c = _neighbour_coefficient(u, s, coef)
         if c != 0.0:
             for j in range(k):
                 out[u, j] += c * X[w, j]
-        c = _neighbour_coefficient(w, s, cb, cp, cc)
+        c = _neighbour_coefficient(w, s, coef)
         if c != 0.0:
             for j in range(k):
                 out[w, j] += c * X[u, j]
@@ -406,64 +393,66 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, 
             c3 = F[f, 2]
             for j in range(k):
                 out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
-    return out
 
 
 @njit(cache=True)
-def build_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, cb, cp, cc,
-                 bnext, bprev, n_new):
-    """The step's refinement matrix S as CSR arrays (indptr, indices, data)."""
-    n = ca.shape[0]
+def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
+    """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
+    n = coef.shape[1]
     m = F.shape[0]
-    nh = 3 * m
-    size = np.zeros(n_new + 1, np.int64)
+    n_new = indptr.shape[0] - 1
     for v in range(n):
-        size[v + 1] = 1
-    for h in range(nh):
+        indptr[v + 1] = 1
+    for h in range(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
             continue
         u = _origin(F, h)
         w = _dest(F, h)
         s = _sharpness(h, twin, hsharp, has_tags)
-        if _neighbour_coefficient(u, s, cb, cp, cc) != 0.0:
-            size[u + 1] += 1
-        if _neighbour_coefficient(w, s, cb, cp, cc) != 0.0:
-            size[w + 1] += 1
+        if _neighbour_coefficient(u, s, coef) != 0.0:
+            indptr[u + 1] += 1
+        if _neighbour_coefficient(w, s, coef) != 0.0:
+            indptr[w + 1] += 1
         r = edge_point[h]
         if r < 0:
             continue
         if hkind[h] == EDGE_TRISECT:
-            size[r + 1] = 3
-            size[r + 2] = 3
+            indptr[r + 1] = 3
+            indptr[r + 2] = 3
         else:
-            size[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
+            indptr[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
     for f in range(m):
         if face_point[f] >= 0:
-            size[face_point[f] + 1] = 3
+            indptr[face_point[f] + 1] = 3
     for r in range(n_new):
-        size[r + 1] += size[r]
-    indptr = size
-    indices = np.empty(indptr[n_new], np.int64)
-    data = np.empty(indptr[n_new], np.float64)
+        indptr[r + 1] += indptr[r]
+
+
+@njit(cache=True)
+def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr,
+                indices, data):
+    """Fill the CSR ``indices`` and ``data`` of the step's matrix, rows in apply_step's order."""
+    n = coef.shape[1]
+    m = F.shape[0]
     fill = indptr[:n].copy()
     for v in range(n):
         indices[fill[v]] = v
-        data[fill[v]] = ca[v]
+        data[fill[v]] = coef[0, v]
         fill[v] += 1
-    for h in range(nh):
+    for h in range(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
             continue
         u = _origin(F, h)
         w = _dest(F, h)
         s = _sharpness(h, twin, hsharp, has_tags)
-        c = _neighbour_coefficient(u, s, cb, cp, cc)
+        c = _neighbour_coefficient(u, s, coef)
         if c != 0.0:
             indices[fill[u]] = w
             data[fill[u]] = c
             fill[u] += 1
-        c = _neighbour_coefficient(w, s, cb, cp, cc)
+        c = _neighbour_coefficient(w, s, coef)
         if c != 0.0:
             indices[fill[w]] = u
             data[fill[w]] = c
@@ -503,7 +492,6 @@ def build_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, ca, c
             for i in range(3):
                 indices[q + i] = F[f, i]
                 data[q + i] = _THIRD
-    return indptr, indices, data
 
 
 # ---------------------------------------------------------------------------------------
@@ -584,11 +572,10 @@ def _flip_start_twin(t, hkind, face_point, first):
 
 
 @njit(cache=True)
-def child_offsets(hkind, face_sharp):
-    """First child face of every face (``offsets``, m + 1) and of every halfedge (``first``)."""
+def child_offsets(hkind, face_sharp, offsets, first):
+    """Fill the first child face of every face (``offsets``, m + 1) and of every halfedge
+    (``first``, 3m)."""
     m = face_sharp.shape[0]
-    offsets = np.empty(m + 1, np.int64)
-    first = np.empty(3 * m, np.int64)
     o = 0
     for f in range(m):
         offsets[f] = o
@@ -601,21 +588,15 @@ def child_offsets(hkind, face_sharp):
                 first[3 * f + i] = o
                 o += 2 if hkind[3 * f + i] == EDGE_SPLIT else 1
     offsets[m] = o
-    return offsets, first
 
 
 @njit(cache=True)
 def emit_children(F, twin, hsharp, has_tags, hkind, edge_point, face_point, face_sharp, offsets, first,
-                  want_topology):
-    """Faces of the next level; with ``want_topology`` also their twins, halfedge sharpness
-    (children of creases with s > 1 carry s − 1) and sharp-face mask."""
+                  want_topology, out, tw, hs, fs):
+    """Fill ``out`` with the faces of the next level; with ``want_topology`` also ``tw``
+    with their twins, ``hs`` (zeroed; when ``has_tags``) with halfedge sharpness (children of
+    creases with s > 1 carry s − 1) and ``fs`` (zeroed) with the sharp-face mask."""
     m = F.shape[0]
-    total = offsets[m]
-    out = np.empty((total, 3), np.int64)
-    nt = 3 * total if want_topology else 0
-    tw = np.empty(nt, np.int64)
-    hs = np.zeros(nt if has_tags else 0, np.float64)
-    fs = np.zeros(total if want_topology else 0, np.bool_)
     for f in range(m):
         o = offsets[f]
         if face_sharp[f]:
@@ -715,4 +696,3 @@ def emit_children(F, twin, hsharp, has_tags, hkind, edge_point, face_point, face
                             tw[3 * q + 2] = -1
                         else:
                             tw[3 * q + 2] = 3 * first[3 * f + j] + 2
-    return out, tw, hs, fs

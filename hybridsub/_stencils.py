@@ -21,18 +21,21 @@ INT32_LIMIT = np.iinfo(np.int32).max
 
 def step_matrix(level: Level, plan: StepPlan) -> sp.csr_matrix:
     """The (n_new, n) refinement matrix of one step."""
-    indptr, indices, data = K.build_matrix(*step_arguments(level, plan))
-    return _csr(data, indices, indptr, (plan.n_new, level.n_vertices))
+    args = step_arguments(level, plan)
+    shape = (plan.n_new, level.n_vertices)
+    indptr = np.zeros(plan.n_new + 1, np.int64)
+    K.matrix_row_sizes(*args, indptr)
+    nnz = int(indptr[-1])
+    index = np.int32 if max(shape[0], shape[1], nnz) < INT32_LIMIT else np.int64
+    indices = np.empty(nnz, index)
+    data = np.empty(nnz, np.float64)
+    K.fill_matrix(*args, indptr, indices, data)
+    return sp.csr_matrix((data, indices, indptr.astype(index, copy=False)), shape=shape, copy=False)
 
 
 def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:
     """``S @ X`` for (n, k) float64 data, without forming S."""
-    return K.apply_step(np.ascontiguousarray(X, dtype=np.float64), *step_arguments(level, plan))
-
-
-def _csr(data, indices, indptr, shape) -> sp.csr_matrix:
-    """Wrap CSR arrays without scipy re-checking them; int32 indices where they fit."""
-    if max(shape[0], shape[1], len(data)) < INT32_LIMIT:
-        indices = indices.astype(np.int32)
-        indptr = indptr.astype(np.int32)
-    return sp.csr_matrix((data, indices, indptr), shape=shape, copy=False)
+    X = np.ascontiguousarray(X, dtype=np.float64)
+    out = np.empty((plan.n_new, X.shape[1]), np.float64)
+    K.apply_step(X, *step_arguments(level, plan), out)
+    return out

@@ -173,7 +173,7 @@ class StepPlan:
     hkind: np.ndarray  # (3m,) int8 EDGE_* code of each halfedge's edge
     edge_point: np.ndarray  # (3m,) index of the (first) new point on each halfedge's edge, −1 if none
     face_point: np.ndarray  # (m,) index of the face point, −1 if none
-    coefficients: tuple  # (ca, cb, cp, cc), each (n,): every vertex mask, see _rules.vertex_mask
+    coefficients: np.ndarray  # (4, n): every vertex mask, see _rules.vertex_mask
     n_new: int
     bnext: np.ndarray  # (3m,) boundary links, only filled for Kobbelt's even steps
     bprev: np.ndarray
@@ -186,18 +186,21 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     ``"sqrt3"``); ``corner`` (n,) is the corner mask.
     """
     F, twin = level.faces, level.twin
-    code = R.SCHEME_CODES[scheme]
+    m, n = level.n_faces, level.n_vertices
     odd = step % 2 == 1
     sqrt3 = scheme == "sqrt3"
-    face_sharp = level.face_sharp
     has_tags = level.hsharp is not None and not sqrt3
-    hsharp = level.hsharp if has_tags else _EMPTY_F
-    (hkind, edge_point, face_point, n_new, valence, c_parent, c_child, n_frac, s_frac, n_faces,
-     n_sharp) = K.classify_step(F, twin, hsharp, has_tags, face_sharp, level.n_vertices, code, odd)
-    table = R.smooth_weight_table(int(valence.max()) if len(valence) else 0, loop_weights)
+    hkind = np.empty(3 * m, np.int8)
+    edge_point = np.empty(3 * m, np.int64)
+    face_point = np.empty(m, np.int64)
+    counts = np.zeros((6, n), np.int64)
+    s_frac = np.zeros(n, np.float64)
+    n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp,
+                            R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, counts, s_frac)
+    table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
-    coefficients = K.vertex_coefficients(valence, c_parent, c_child, n_frac, s_frac, n_faces, n_sharp, corner,
-                                         table, cs, cn, sqrt3 and odd)
+    coefficients = np.empty((4, n), np.float64)
+    K.vertex_coefficients(counts, s_frac, corner, table, cs, cn, sqrt3 and odd, coefficients)
     if sqrt3 and not odd:
         bnext, bprev = K.boundary_links(F, twin)
     else:
@@ -210,10 +213,10 @@ _EMPTY_I = np.empty(0, np.int64)
 
 
 def step_arguments(level: Level, plan: StepPlan) -> tuple:
-    """The arguments apply_step and build_matrix share, in their order (after the data)."""
+    """The arguments the stencil kernels share, in their order."""
     has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
     return (level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
-            plan.edge_point, plan.face_point, *plan.coefficients, plan.bnext, plan.bprev, plan.n_new)
+            plan.edge_point, plan.face_point, plan.coefficients, plan.bnext, plan.bprev)
 
 
 def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
@@ -221,12 +224,20 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
 
     Without ``want_topology`` only the faces are built (for the last step of a call).
     """
+    m = level.n_faces
     face_sharp = level.face_sharp
-    offsets, first = K.child_offsets(plan.hkind, face_sharp)
+    offsets = np.empty(m + 1, np.int64)
+    first = np.empty(3 * m, np.int64)
+    K.child_offsets(plan.hkind, face_sharp, offsets, first)
+    total = int(offsets[m])
     has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
-    faces, twin, hsharp, child_sharp = K.emit_children(
-        level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
-        plan.edge_point, plan.face_point, face_sharp, offsets, first, want_topology)
+    faces = np.empty((total, 3), np.int64)
+    twin = np.empty(3 * total if want_topology else 0, np.int64)
+    hsharp = np.zeros(3 * total if want_topology and has_tags else 0)
+    child_sharp = np.zeros(total if want_topology else 0, bool)
+    K.emit_children(level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
+                    plan.edge_point, plan.face_point, face_sharp, offsets, first, want_topology, faces, twin,
+                    hsharp, child_sharp)
     child = None
     if want_topology:
         child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
