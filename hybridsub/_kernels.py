@@ -13,8 +13,8 @@ One step runs ``classify_step`` (edge kinds, new-point layout, vertex statistics
 ``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``), then either
 ``apply_step`` (positions directly) or ``matrix_row_sizes`` and ``fill_matrix`` (the CSR
 matrix S) — all walk the same rows in the same order, so ``apply_step(X) == S @ X`` bit for
-bit — and ``emit_children`` (the next level's faces, twins and tags, derived from this level's
-instead of re-derived).
+bit — and ``emit_faces`` with ``emit_topology`` (the next level's faces, then its twins and
+tags, derived from this level's instead of searched again).
 """
 
 from __future__ import annotations
@@ -228,11 +228,12 @@ def _sharpness(h, twin, hsharp, has_tags):
 
 @njit(cache=True)
 def classify_step(F, twin, hsharp, has_tags, face_sharp, scheme, odd, hkind, edge_point, face_point,
-                  counts, s_frac):
+                  trisected, counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
 
     Fills ``hkind`` and ``edge_point`` (3m,): each halfedge's edge kind and the index of the
-    (first) point on its edge or −1; ``face_point`` (m,) likewise. ``counts`` (6, n), zeroed
+    (first) point on its edge or −1; ``face_point`` (m,) likewise; ``trisected`` (m,) the
+    local index of a face's trisected boundary halfedge or −1. ``counts`` (6, n), zeroed
     by the caller, receives per vertex: valence, incident edges with s > 0, with s > 1, with
     0 < s ≤ 1, incident faces, incident sharp faces; ``s_frac`` (n,), zeroed, the sum of s
     over edges with 0 < s ≤ 1. Returns the number of vertices of the next level.
@@ -282,8 +283,14 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, scheme, odd, hkind, edg
                 s_frac[u] += s
                 s_frac[w] += s
     for f in range(m):
+        trisected[f] = -1
         if sqrt3:
-            has = odd or (twin[3 * f] >= 0 and twin[3 * f + 1] >= 0 and twin[3 * f + 2] >= 0)
+            has = True
+            if not odd:
+                for i in range(3):
+                    if twin[3 * f + i] < 0:
+                        has = False
+                        trisected[f] = i
         else:
             has = not face_sharp[f]
         if has:
@@ -540,32 +547,26 @@ def _spoke_in(h, twin, hkind, first):
 
 
 @njit(cache=True, inline="always")
-def _trisected_at(g, hkind):
-    """Local index of the trisected boundary halfedge of face g (−1 if none)."""
-    for j in range(3):
-        if hkind[3 * g + j] == EDGE_TRISECT:
-            return j
-    return -1
-
-
-@njit(cache=True, inline="always")
-def _apex(g, hg, hkind, edge_point, face_point):
-    """The new vertex face g gives the flipped edge across its halfedge hg."""
-    if face_point[g] >= 0:
-        return face_point[g]
-    j = _trisected_at(g, hkind)
+def _apex(g, hg, trisected, edge_point, face_point):
+    """The new vertex face g gives the flipped edge across its halfedge hg: its face point,
+    or for a face trisected along its halfedge j, e2 across the next halfedge, e1 across
+    the one after."""
+    fp = face_point[g]
+    if fp >= 0:
+        return fp
+    j = trisected[g]
     if hg == 3 * g + (j + 1) % 3:
         return edge_point[3 * g + j] + 1
     return edge_point[3 * g + j]
 
 
 @njit(cache=True, inline="always")
-def _flip_start_twin(t, hkind, face_point, first):
+def _flip_start_twin(t, hkind, trisected, face_point, first):
     """Twin of the flip triangle's halfedge u→apex(g), g the face of t (t = w→u)."""
     g = t // 3
     if face_point[g] >= 0:
         return _spoke_out(_next(t), hkind, first)
-    j = _trisected_at(g, hkind)
+    j = trisected[g]
     if t == 3 * g + (j + 1) % 3:
         return 3 * first[3 * g + j] + 1
     return -1
@@ -591,14 +592,11 @@ def child_offsets(hkind, face_sharp, offsets, first):
 
 
 @njit(cache=True)
-def emit_children(F, twin, hsharp, has_tags, hkind, edge_point, face_point, face_sharp, offsets, first,
-                  want_topology, out, tw, hs, fs):
-    """Fill ``out`` with the faces of the next level; with ``want_topology`` also ``tw``
-    with their twins, ``hs`` (zeroed; when ``has_tags``) with halfedge sharpness (children of
-    creases with s > 1 carry s − 1) and ``fs`` (zeroed) with the sharp-face mask."""
+def emit_faces(F, twin, hkind, edge_point, face_point, trisected, face_sharp, first, out):
+    """Fill ``out`` with the faces of the next level, in parent order."""
     m = F.shape[0]
     for f in range(m):
-        o = offsets[f]
+        o = first[3 * f]
         if face_sharp[f]:
             m0 = edge_point[3 * f]
             m1 = edge_point[3 * f + 1]
@@ -615,84 +613,101 @@ def emit_children(F, twin, hsharp, has_tags, hkind, edge_point, face_point, face
             out[o + 3, 0] = m0
             out[o + 3, 1] = m1
             out[o + 3, 2] = m2
-            if want_topology:
-                for q in range(4):
-                    fs[o + q] = True
-                c3 = 3 * (o + 3)
-                tw[3 * o + 1] = c3 + 2
-                tw[3 * (o + 1) + 2] = c3
-                tw[3 * (o + 2)] = c3 + 1
-                tw[c3] = 3 * (o + 1) + 2
-                tw[c3 + 1] = 3 * (o + 2)
-                tw[c3 + 2] = 3 * o + 1
-                for i in range(3):
-                    h = 3 * f + i
-                    t = twin[h]
-                    a = _first_half(h, face_sharp, first)
-                    b = _second_half(h, face_sharp, first)
-                    tw[a] = _second_half(t, face_sharp, first) if t >= 0 else -1
-                    tw[b] = _first_half(t, face_sharp, first) if t >= 0 else -1
-                    if has_tags and t >= 0 and hsharp[h] > 1.0:
-                        s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
-                        hs[a] = s
-                        hs[b] = s
             continue
         cf = face_point[f]
         for i in range(3):
             h = 3 * f + i
-            u = F[f, i]
-            w = F[f, (i + 1) % 3]
+            k = hkind[h]
+            if k == EDGE_FLIP:
+                t = twin[h]
+                out[o, 0] = F[f, i]
+                out[o, 1] = _apex(t // 3, t, trisected, edge_point, face_point)
+                out[o, 2] = cf if cf >= 0 else _apex(f, h, trisected, edge_point, face_point)
+                o += 1
+            elif k == EDGE_SPLIT:
+                mid = edge_point[h]
+                out[o, 0] = cf
+                out[o, 1] = F[f, i]
+                out[o, 2] = mid
+                out[o + 1, 0] = cf
+                out[o + 1, 1] = mid
+                out[o + 1, 2] = F[f, (i + 1) % 3]
+                o += 2
+            elif k == EDGE_KEEP:
+                out[o, 0] = cf
+                out[o, 1] = F[f, i]
+                out[o, 2] = F[f, (i + 1) % 3]
+                o += 1
+            else:  # EDGE_TRISECT
+                out[o, 0] = edge_point[h]
+                out[o, 1] = edge_point[h] + 1
+                out[o, 2] = F[f, (i + 2) % 3]
+                o += 1
+
+
+@njit(cache=True)
+def emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs):
+    """Fill the next level's twins ``tw``, halfedge sharpness ``hs`` (zeroed; when
+    ``has_tags``: children of creases with s > 1 carry s − 1) and sharp-face mask ``fs``
+    (zeroed), derived from this level's (no search)."""
+    m = face_sharp.shape[0]
+    for f in range(m):
+        o = first[3 * f]
+        if face_sharp[f]:
+            for q in range(4):
+                fs[o + q] = True
+            c3 = 3 * (o + 3)
+            tw[3 * o + 1] = c3 + 2
+            tw[3 * (o + 1) + 2] = c3
+            tw[3 * (o + 2)] = c3 + 1
+            tw[c3] = 3 * (o + 1) + 2
+            tw[c3 + 1] = 3 * (o + 2)
+            tw[c3 + 2] = 3 * o + 1
+            for i in range(3):
+                h = 3 * f + i
+                t = twin[h]
+                a = _first_half(h, face_sharp, first)
+                b = _second_half(h, face_sharp, first)
+                tw[a] = _second_half(t, face_sharp, first) if t >= 0 else -1
+                tw[b] = _first_half(t, face_sharp, first) if t >= 0 else -1
+                if has_tags and t >= 0 and hsharp[h] > 1.0:
+                    s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
+                    hs[a] = s
+                    hs[b] = s
+            continue
+        cf = face_point[f]
+        for i in range(3):
+            h = 3 * f + i
             k = hkind[h]
             q = first[h]
             t = twin[h]
             if k == EDGE_SPLIT:
-                mid = edge_point[h]
-                out[q, 0] = cf
-                out[q, 1] = u
-                out[q, 2] = mid
-                out[q + 1, 0] = cf
-                out[q + 1, 1] = mid
-                out[q + 1, 2] = w
-                if want_topology:
-                    tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
-                    tw[3 * q + 1] = _second_half(t, face_sharp, first) if t >= 0 else -1
-                    tw[3 * q + 2] = 3 * (q + 1)
-                    tw[3 * (q + 1)] = 3 * q + 2
-                    tw[3 * (q + 1) + 1] = _first_half(t, face_sharp, first) if t >= 0 else -1
-                    tw[3 * (q + 1) + 2] = _spoke_out(_next(h), hkind, first)
-                    if has_tags and t >= 0 and hsharp[h] > 1.0:
-                        s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
-                        hs[3 * q + 1] = s
-                        hs[3 * (q + 1) + 1] = s
+                tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                tw[3 * q + 1] = _second_half(t, face_sharp, first) if t >= 0 else -1
+                tw[3 * q + 2] = 3 * (q + 1)
+                tw[3 * (q + 1)] = 3 * q + 2
+                tw[3 * (q + 1) + 1] = _first_half(t, face_sharp, first) if t >= 0 else -1
+                tw[3 * (q + 1) + 2] = _spoke_out(_next(h), hkind, first)
+                if has_tags and t >= 0 and hsharp[h] > 1.0:
+                    s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
+                    hs[3 * q + 1] = s
+                    hs[3 * (q + 1) + 1] = s
             elif k == EDGE_KEEP:
-                out[q, 0] = cf
-                out[q, 1] = u
-                out[q, 2] = w
-                if want_topology:
-                    tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
-                    tw[3 * q + 1] = -1
-                    tw[3 * q + 2] = _spoke_out(_next(h), hkind, first)
+                tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                tw[3 * q + 1] = -1
+                tw[3 * q + 2] = _spoke_out(_next(h), hkind, first)
             elif k == EDGE_TRISECT:
-                x = F[f, (i + 2) % 3]
-                out[q, 0] = edge_point[h]
-                out[q, 1] = edge_point[h] + 1
-                out[q, 2] = x
-                if want_topology:
-                    tw[3 * q] = -1
-                    tw[3 * q + 1] = 3 * first[twin[_next(h)]]
-                    tw[3 * q + 2] = 3 * first[_prev(h)] + 2
+                tw[3 * q] = -1
+                tw[3 * q + 1] = 3 * first[twin[_next(h)]]
+                tw[3 * q + 2] = 3 * first[_prev(h)] + 2
             else:  # EDGE_FLIP
-                out[q, 0] = u
-                out[q, 1] = _apex(t // 3, t, hkind, edge_point, face_point)
-                out[q, 2] = _apex(f, h, hkind, edge_point, face_point)
-                if want_topology:
-                    tw[3 * q] = _flip_start_twin(t, hkind, face_point, first)
-                    tw[3 * q + 1] = 3 * first[t] + 1
-                    if cf >= 0:
-                        tw[3 * q + 2] = _spoke_in(_prev(h), twin, hkind, first)
-                    else:  # f trisected along its halfedge j: h is its second or third halfedge
-                        j = _trisected_at(f, hkind)
-                        if i == (j + 1) % 3:
-                            tw[3 * q + 2] = -1
-                        else:
-                            tw[3 * q + 2] = 3 * first[3 * f + j] + 2
+                tw[3 * q] = _flip_start_twin(t, hkind, trisected, face_point, first)
+                tw[3 * q + 1] = 3 * first[t] + 1
+                if cf >= 0:
+                    tw[3 * q + 2] = _spoke_in(_prev(h), twin, hkind, first)
+                else:  # f trisected along its halfedge j: h is its second or third halfedge
+                    j = trisected[f]
+                    if i == (j + 1) % 3:
+                        tw[3 * q + 2] = -1
+                    else:
+                        tw[3 * q + 2] = 3 * first[3 * f + j] + 2

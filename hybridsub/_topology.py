@@ -173,6 +173,7 @@ class StepPlan:
     hkind: np.ndarray  # (3m,) int8 EDGE_* code of each halfedge's edge
     edge_point: np.ndarray  # (3m,) index of the (first) new point on each halfedge's edge, −1 if none
     face_point: np.ndarray  # (m,) index of the face point, −1 if none
+    trisected: np.ndarray  # (m,) int8 local index of the trisected boundary halfedge, −1 if none
     coefficients: np.ndarray  # (4, n): every vertex mask, see _rules.vertex_mask
     n_new: int
     bnext: np.ndarray  # (3m,) boundary links, only filled for Kobbelt's even steps
@@ -193,10 +194,12 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     hkind = np.empty(3 * m, np.int8)
     edge_point = np.empty(3 * m, np.int64)
     face_point = np.empty(m, np.int64)
+    trisected = np.empty(m, np.int8)
     counts = np.zeros((6, n), np.int64)
     s_frac = np.zeros(n, np.float64)
     n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp,
-                            R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, counts, s_frac)
+                            R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts,
+                            s_frac)
     table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
@@ -205,7 +208,8 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
         bnext, bprev = K.boundary_links(F, twin)
     else:
         bnext = bprev = _EMPTY_I
-    return StepPlan(scheme, step, hkind, edge_point, face_point, coefficients, int(n_new), bnext, bprev)
+    return StepPlan(scheme, step, hkind, edge_point, face_point, trisected, coefficients, int(n_new), bnext,
+                    bprev)
 
 
 _EMPTY_F = np.empty(0, np.float64)
@@ -235,11 +239,12 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     twin = np.empty(3 * total if want_topology else 0, np.int64)
     hsharp = np.zeros(3 * total if want_topology and has_tags else 0)
     child_sharp = np.zeros(total if want_topology else 0, bool)
-    K.emit_children(level.faces, level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind,
-                    plan.edge_point, plan.face_point, face_sharp, offsets, first, want_topology, faces, twin,
-                    hsharp, child_sharp)
+    K.emit_faces(level.faces, level.twin, plan.hkind, plan.edge_point, plan.face_point, plan.trisected, face_sharp,
+                 first, faces)
     child = None
     if want_topology:
+        K.emit_topology(level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind, plan.face_point,
+                        plan.trisected, face_sharp, first, twin, hsharp, child_sharp)
         child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
     return faces, child, offsets
 
