@@ -20,7 +20,9 @@ tags, derived from this level's instead of searched again).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+import types
+
+from numba import njit, prange
 
 from ._rules import (
     CORNER,
@@ -46,6 +48,21 @@ ERR_MULTIPLE_TWINS = 2  # several halfedges w→u for one u→w
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
 _THIRD = 1.0 / 3.0
+
+#: Inputs smaller than this (faces or rows) run the serial twin of a threaded kernel:
+#: starting threads costs more than the work.
+PARALLEL_MIN = 20000
+
+
+def _threaded_and_serial(fn):
+    """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
+    as ``range``). The serial twin is a copy of the function under its own name, so the
+    two have separate on-disk caches."""
+    serial = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__,
+                                fn.__closure__)
+    serial.__qualname__ = fn.__qualname__ + "_serial"
+    serial.__doc__ = fn.__doc__
+    return njit(cache=True, parallel=True)(fn), njit(cache=True)(serial)
 
 
 @njit(cache=True, inline="always")
@@ -74,7 +91,7 @@ def _prev(h):
 
 
 # ---------------------------------------------------------------------------------------
-# Topology of an input mesh (level 0). Later levels get their twins from emit_children.
+# Topology of an input mesh (level 0). Later levels get their twins from emit_topology.
 
 
 @njit(cache=True)
@@ -349,9 +366,12 @@ def _neighbour_coefficient(v, s, coef):
     return c
 
 
-@njit(cache=True)
-def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out):
-    """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S."""
+def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out):
+    """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
+
+    Old vertices gather from their neighbours in edge order (serially: rows are summed in
+    one fixed order); edge and face points, one row each, are computed in parallel.
+    """
     n = coef.shape[1]
     k = X.shape[1]
     m = F.shape[0]
@@ -373,9 +393,13 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef
         if c != 0.0:
             for j in range(k):
                 out[w, j] += c * X[u, j]
+    for h in prange(3 * m):
         r = edge_point[h]
-        if r < 0:
+        t = twin[h]
+        if r < 0 or (t >= 0 and t < h):
             continue
+        u = _origin(F, h)
+        w = _dest(F, h)
         if hkind[h] == EDGE_TRISECT:
             p0 = _origin(F, bprev[h])
             p3 = _dest(F, bnext[h])
@@ -383,7 +407,7 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef
                 out[r, j] = _T0 * X[p0, j] + _T1 * X[u, j] + _T2 * X[w, j]
                 out[r + 1, j] = _T2 * X[u, j] + _T1 * X[w, j] + _T0 * X[p3, j]
             continue
-        wab, wcd = edge_weights(s)
+        wab, wcd = edge_weights(_sharpness(h, twin, hsharp, has_tags))
         if wcd == 0.0:
             for j in range(k):
                 out[r, j] = wab * X[u, j] + wab * X[w, j]
@@ -392,7 +416,7 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef
             b = _opposite(F, t)
             for j in range(k):
                 out[r, j] = wab * X[u, j] + wab * X[w, j] + wcd * X[a, j] + wcd * X[b, j]
-    for f in range(m):
+    for f in prange(m):
         r = face_point[f]
         if r >= 0:
             a = F[f, 0]
@@ -400,6 +424,9 @@ def apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef
             c3 = F[f, 2]
             for j in range(k):
                 out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
+
+
+apply_step, apply_step_serial = _threaded_and_serial(_apply_step)
 
 
 @njit(cache=True)
@@ -501,6 +528,22 @@ def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, 
                 data[q + i] = _THIRD
 
 
+def _csr_apply(indptr, indices, data, X, out):
+    """``out = S @ X`` for CSR S, rows in parallel, each summed in stored order (as SciPy)."""
+    k = X.shape[1]
+    for r in prange(indptr.shape[0] - 1):
+        for j in range(k):
+            out[r, j] = 0.0
+        for q in range(indptr[r], indptr[r + 1]):
+            c = indices[q]
+            w = data[q]
+            for j in range(k):
+                out[r, j] += w * X[c, j]
+
+
+csr_apply, csr_apply_serial = _threaded_and_serial(_csr_apply)
+
+
 # ---------------------------------------------------------------------------------------
 # The next level: faces in parent order, and their twins and tags derived from this level.
 #
@@ -591,11 +634,10 @@ def child_offsets(hkind, face_sharp, offsets, first):
     offsets[m] = o
 
 
-@njit(cache=True)
-def emit_faces(F, twin, hkind, edge_point, face_point, trisected, face_sharp, first, out):
+def _emit_faces(F, twin, hkind, edge_point, face_point, trisected, face_sharp, first, out):
     """Fill ``out`` with the faces of the next level, in parent order."""
     m = F.shape[0]
-    for f in range(m):
+    for f in prange(m):
         o = first[3 * f]
         if face_sharp[f]:
             m0 = edge_point[3 * f]
@@ -645,13 +687,15 @@ def emit_faces(F, twin, hkind, edge_point, face_point, trisected, face_sharp, fi
                 o += 1
 
 
-@njit(cache=True)
-def emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs):
+emit_faces, emit_faces_serial = _threaded_and_serial(_emit_faces)
+
+
+def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs):
     """Fill the next level's twins ``tw``, halfedge sharpness ``hs`` (zeroed; when
     ``has_tags``: children of creases with s > 1 carry s − 1) and sharp-face mask ``fs``
     (zeroed), derived from this level's (no search)."""
     m = face_sharp.shape[0]
-    for f in range(m):
+    for f in prange(m):
         o = first[3 * f]
         if face_sharp[f]:
             for q in range(4):
@@ -711,3 +755,6 @@ def emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sha
                         tw[3 * q + 2] = -1
                     else:
                         tw[3 * q + 2] = 3 * first[3 * f + j] + 2
+
+
+emit_topology, emit_topology_serial = _threaded_and_serial(_emit_topology)

@@ -14,7 +14,7 @@ import scipy.sparse as sp
 
 from . import _validate as val
 from ._errors import MeshError
-from ._stencils import apply_step, step_matrix
+from ._stencils import apply_matrix, apply_step, step_matrix
 from ._topology import build_level, child_creases, child_level, face_parents, plan_step
 
 
@@ -121,10 +121,10 @@ class Refinement:
         out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
         Y = np.asarray(A, dtype=np.float64).reshape(self.n_coarse, -1)
         if "matrix" in self._cache:
-            Y = self._cache["matrix"] @ Y
+            Y = apply_matrix(self._cache["matrix"], Y)
         else:
             for st in self.steps:
-                Y = st.matrix @ Y
+                Y = apply_matrix(st.matrix, Y)
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
 
 

@@ -239,12 +239,15 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     twin = np.empty(3 * total if want_topology else 0, np.int64)
     hsharp = np.zeros(3 * total if want_topology and has_tags else 0)
     child_sharp = np.zeros(total if want_topology else 0, bool)
-    K.emit_faces(level.faces, level.twin, plan.hkind, plan.edge_point, plan.face_point, plan.trisected, face_sharp,
-                 first, faces)
+    big = m >= K.PARALLEL_MIN
+    (K.emit_faces if big else K.emit_faces_serial)(
+        level.faces, level.twin, plan.hkind, plan.edge_point, plan.face_point, plan.trisected, face_sharp, first,
+        faces)
     child = None
     if want_topology:
-        K.emit_topology(level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind, plan.face_point,
-                        plan.trisected, face_sharp, first, twin, hsharp, child_sharp)
+        (K.emit_topology if big else K.emit_topology_serial)(
+            level.twin, level.hsharp if has_tags else _EMPTY_F, has_tags, plan.hkind, plan.face_point,
+            plan.trisected, face_sharp, first, twin, hsharp, child_sharp)
         child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
     return faces, child, offsets
 

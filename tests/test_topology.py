@@ -70,3 +70,28 @@ def test_direct_application_equals_matrix_bit_for_bit(data, scheme, levels):
         Y = apply_step(level, plan, X)
         assert np.array_equal(Y, step_matrix(level, plan) @ X)
         X = Y
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tagged_meshes("any"), st.sampled_from(["hybrid", "loop", "sqrt3"]), st.integers(1, 3))
+def test_threaded_kernels_equal_serial_bit_for_bit(data, scheme, levels):
+    """Small meshes run the serial twins; forcing the threaded ones must change no bit."""
+    import hybridsub
+    from hybridsub import _kernels
+
+    V, F, tags = data
+    if scheme == "sqrt3":
+        tags = {}
+    serial = hybridsub.subdivide(V, F, levels=levels, scheme=scheme, **tags)
+    r = hybridsub.refine(F, levels=levels, n_vertices=len(V), scheme=scheme, **tags)
+    serial_apply = r.apply(V)
+    saved = _kernels.PARALLEL_MIN
+    _kernels.PARALLEL_MIN = 0
+    try:
+        threaded = hybridsub.subdivide(V, F, levels=levels, scheme=scheme, **tags)
+        threaded_apply = r.apply(V)
+    finally:
+        _kernels.PARALLEL_MIN = saved
+    assert np.array_equal(serial[0], threaded[0]) and np.array_equal(serial[1], threaded[1])
+    assert np.array_equal(serial_apply, threaded_apply)
+    assert np.array_equal(serial_apply, serial[0])
