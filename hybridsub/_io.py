@@ -158,7 +158,8 @@ def _polygons(path: str, polys: list, triangulate: bool, what: str = "face"):
         f = int(bad[0])
         raise MeshError(
             f"{path}: {what} {f} has {int(sizes[f])} vertices ({len(bad)} of {len(polys)} faces are not triangles): "
-            "hybridsub subdivides triangle meshes; triangulate first (command line: --triangulate)"
+            "hybridsub subdivides triangle meshes; triangulate it first (--triangulate on the command line, "
+            "read_mesh(..., triangulate=True) in Python)"
         )
     small = np.flatnonzero(sizes < 3)
     if len(small):

@@ -85,7 +85,7 @@ def _si(x: float) -> str:
     for unit, div in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
         if x >= div:
             return f"{x / div:.1f} {unit}"
-    return f"{x:.0f} "
+    return f"{x:.0f}"
 
 
 class ProgressBar:
@@ -108,16 +108,16 @@ class ProgressBar:
         if not self.enabled:
             return
         rate = n_faces / seconds if seconds > 0 else float("inf")
-        info = f"level {done}/{levels}  {n_faces:,} faces  {_si(rate)}faces/s"
+        info = f"level {done}/{levels}: {n_faces:,} faces, {_si(rate)} faces/s"
         if done < levels:
             nxt = int(self.cum[min(done + 1, self.levels)] - self.cum[done])
-            info += f"  (next: {nxt:,} faces)"
+            info += f"; next {nxt:,}"
         self._draw(done, info)
 
     def _draw(self, done: int, info: str) -> None:
         width = shutil.get_terminal_size((80, 20)).columns
         frac = self.cum[done] / self.cum[-1] if self.cum[-1] > 0 else 1.0
-        bar_w = max(10, min(30, width - len(info) - len(self.label) - 12))
+        bar_w = 20 if width >= 100 else 10
         full = int(round(frac * bar_w))
         line = f"{self.label} [{'#' * full}{'.' * (bar_w - full)}] {frac * 100:3.0f}%  {info}"
         self.stream.write("\r" + line[:width - 1].ljust(width - 1))
