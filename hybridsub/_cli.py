@@ -108,8 +108,8 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     if angle is not None:
         try:
             feat = detect_features(mesh.vertices, mesh.faces, angle)
-        except MeshError as e:
-            raise CLIError(f"{path}: {e}") from None
+        except MeshError as err:
+            raise CLIError(f"{path}: {err}") from None
         E.append(feat.sharp_edges)
         S.append(np.full(len(feat.sharp_edges), np.inf))
         C.append(feat.corners)
@@ -121,13 +121,12 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
             what = "none (a closed mesh without tags: smooth everywhere)"
         return Features(np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64), np.empty(0, np.int64),
                         f"features: {what}; --feature-angle 30 would detect creases")
-    e = np.vstack(E) if E else np.empty((0, 2), np.int64)
-    s = np.concatenate(S) if S else np.empty(0)
-    e, s = _merge_edges(e, s, n)
+    edges, sharp = _merge_edges(np.vstack(E) if E else np.empty((0, 2), np.int64),
+                                np.concatenate(S) if S else np.empty(0), n)
     c = np.unique(np.concatenate(C)) if C else np.empty(0, np.int64)
     sf = np.unique(np.concatenate(SF)) if SF else np.empty(0, np.int64)
-    parts = [_n(len(e), "crease")]
-    semi = int(np.isfinite(s).sum())
+    parts = [_n(len(edges), "crease")]
+    semi = int(np.isfinite(sharp).sum())
     if semi:
         parts[-1] += f" ({semi:,} semi-sharp)"
     parts.append(_n(len(c), "corner"))
@@ -135,7 +134,7 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
         parts.append(_n(len(sf), "sharp face"))
     if n_boundary:
         parts.append(f"{_n(n_boundary, 'boundary edge')} (creases too)")
-    return Features(e, s, sf, c, f"features: {', '.join(parts)} — from {' + '.join(sources)}")
+    return Features(edges, sharp, sf, c, f"features: {', '.join(parts)} — from {' + '.join(sources)}")
 
 
 def _check_edges(e, pairs, n, source, path):

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._features import detect_features
 from ._refine import refine
@@ -16,9 +17,10 @@ if TYPE_CHECKING:  # pragma: no cover
 METADATA_KEY = "hybridsub"
 
 
-def subdivide_mesh(mesh: "trimesh.Trimesh", levels: int = 1, *, scheme: str = "hybrid", sharp_edges=None,
-                   sharpness=None, sharp_faces=None, corners=None, feature_angle: float | None = None,
-                   loop_weights: str = "loop") -> "trimesh.Trimesh":
+def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: str = "hybrid",
+                   sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
+                   sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                   feature_angle: float | None = None, loop_weights: str = "loop") -> trimesh.Trimesh:
     """Subdivide a ``trimesh.Trimesh``, carrying its attributes and features along.
 
     Per-vertex data — colours, texture coordinates stored per vertex, every array in

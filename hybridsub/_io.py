@@ -14,6 +14,7 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _ply
 from ._errors import MeshError
@@ -178,7 +179,8 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
         text = fh.read().replace("\\\n", " ")
     lines = text.splitlines()
     v_lines, vt_lines, f_lines, tags = [], [], [], []
-    notes, ignored = [], set()
+    notes: list[str] = []
+    ignored: set[str] = set()
     for number, line in enumerate(lines, start=1):
         if line.startswith("v "):
             v_lines.append(line[2:])
@@ -250,7 +252,8 @@ def _obj_fast_faces(f_lines):
 
 def _read_obj_slow(path: str, lines: list, triangulate: bool) -> TaggedMesh:
     v_rows, vt_rows, faces, fuv, tags = [], [], [], [], []
-    notes, ignored = [], set()
+    notes: list[str] = []
+    ignored: set[str] = set()
     nv = nvt = 0
     for number, line in enumerate(lines, start=1):
         w = line.split()
@@ -310,7 +313,7 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangu
     if origin is not None:
         notes.append(f"triangulated {len(faces)} polygons into {len(F)} triangles")
     _check_range(path, F, len(V), "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
-    if face_uv is not None:
+    if face_uv is not None and uv is not None:
         _check_range(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}")
     edges, sharpness, corners, sharp_faces, tag_notes, boundary_corners = _parse_tags(path, tags, len(V), len(faces))
     if origin is not None and len(sharp_faces):
@@ -590,8 +593,10 @@ def boundary_corner_vertices(F: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # writing
 
-def write_mesh(path: str | os.PathLike, vertices, faces, *, sharp_edges=None, sharpness=None, corners=None,
-               sharp_faces=None, vertex_colors=None, uv=None, face_uv=None, binary: bool = True) -> None:
+def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *, sharp_edges: ArrayLike | None = None,
+               sharpness: ArrayLike | None = None, corners: ArrayLike | None = None,
+               sharp_faces: ArrayLike | None = None, vertex_colors: ArrayLike | None = None,
+               uv: ArrayLike | None = None, face_uv: ArrayLike | None = None, binary: bool = True) -> None:
     """Write a triangle mesh with its feature tags.
 
     OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
@@ -704,7 +709,7 @@ def _rows(prefix: str, A: np.ndarray, fmt: str) -> list[str]:
     """Format rows of A as text lines, in chunks (one % per chunk is fast in CPython)."""
     if A.size == 0:
         return []
-    row = prefix + " ".join([fmt] * A.shape[1]) + "\n"
+    row = prefix + " ".join([fmt] * (A.shape[1] // fmt.count("%"))) + "\n"
     out, chunk = [], 65536
     for s in range(0, len(A), chunk):
         block = A[s:s + chunk]
@@ -722,7 +727,7 @@ def _write_obj(path: str, m: TaggedMesh) -> None:
         parts += _rows("v ", np.hstack([m.vertices, m.vertex_colors[:, :3]]), "%r")
     else:
         parts += _rows("v ", m.vertices, "%r")
-    if m.uv is not None:
+    if m.uv is not None and m.face_uv is not None:
         parts += _rows("vt ", m.uv, "%r")
         parts += _rows("f ", np.stack([m.faces + 1, m.face_uv + 1], axis=2).reshape(-1, 6), "%d/%d")
     else:
@@ -809,7 +814,7 @@ def _write_trimesh(path: str, m: TaggedMesh, ext: str) -> None:
 # ----------------------------------------------------------------------------------------------
 # small text files for the command line
 
-def read_index_file(path: str, columns: int, what: str) -> np.ndarray:
+def read_index_file(path: str, columns: int, what: str) -> list[list[float]]:
     """Whitespace-separated numbers, '#' comments; (k, columns) float array (k rows)."""
     if not os.path.exists(path):
         raise FileNotFoundError(f"{path}: no such file")

@@ -9,6 +9,8 @@ must find the vertices where the file put them. Only what hybridsub needs is int
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ._errors import MeshError
@@ -26,7 +28,7 @@ class _Element:
         self.name = name
         self.count = count
         self.props: list[tuple] = []  # (name, dtype) or (name, count dtype, item dtype)
-        self.data: dict[str, object] = {}
+        self.data: dict[str, Any] = {}
 
     @property
     def has_lists(self) -> bool:
@@ -151,7 +153,8 @@ def _read_binary(raw: bytes, pos: int, elements: list[_Element], order: str, pat
         if el.count == 0:
             _empty(el)
             continue
-        fields, lengths = [], []
+        fields: list[tuple] = []
+        lengths: list[int] = []
         # Fast path: assume every list has the length of the first record's list.
         probe = pos
         for p in el.props:
@@ -225,7 +228,8 @@ def write_ply(path: str, elements: list[tuple[str, list[tuple]]], *, binary: boo
             if not props or len(props[0][2]) == 0:
                 continue
             if binary:
-                fields, cols = [], []
+                fields: list[tuple] = []
+                cols: list[np.ndarray] = []
                 for prop, dt, values in props:
                     values = np.asarray(values)
                     if values.ndim == 2:
