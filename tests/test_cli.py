@@ -300,7 +300,8 @@ def test_level_by_level_is_one_call(name, scheme):
     kw = {} if scheme == "sqrt3" else dict(sharp_edges=E, sharpness=s, sharp_faces=np.flatnonzero(sf), corners=C)
     for levels in (1, 2, 3):
         r = hybridsub.refine(F, kw.get("sharp_edges"), levels, n_vertices=len(V), scheme=scheme,
-                             sharpness=kw.get("sharpness"), sharp_faces=kw.get("sharp_faces"), corners=kw.get("corners"))
+                             sharpness=kw.get("sharpness"), sharp_faces=kw.get("sharp_faces"),
+                             corners=kw.get("corners"))
         calls = []
         res = refine_by_level(V, F, levels, scheme=scheme, on_level=lambda done, *_: calls.append(done), **kw)
         assert np.array_equal(res.faces, r.faces) and np.array_equal(res.face_parent, r.face_parent)
