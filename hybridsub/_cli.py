@@ -203,10 +203,9 @@ def _check_memory(a, pred: list[dict], what: str) -> None:
 
 
 def _rate(x: float) -> str:
-    for unit, div in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
-        if x >= div:
-            return f"{x / div:.2f} {unit}"
-    return f"{x:.0f}"
+    if x >= 1e6:
+        return f"{x / 1e6:.2f} M"
+    return f"{x / 1e3:.0f} k" if x >= 1e3 else f"{x:.0f}"
 
 
 def _bytes(b: float) -> str:
@@ -391,8 +390,8 @@ def cmd_info(a) -> int:
     for p in pred:
         lines.append(f"                {p['level']:>5} {p['faces']:>12,} {p['vertices']:>12,}  "
                      f"{_bytes(p['output_bytes']):>9}  {_bytes(p['peak_bytes']):>9}")
-    lines.append("                (counts exact; memory estimated from counts: output = float64 positions + "
-                 "int64 faces; peak = one level of hybridsub subdivide)")
+    lines.append("                counts are exact; memory is estimated from them (output: float64 positions and")
+    lines.append("                int64 faces; peak: hybridsub subdivide making that level, holding it and the one before)")
     return _emit(a, lines, out, 0)
 
 
@@ -429,9 +428,10 @@ def cmd_demo(a) -> int:
         feat = gather_features(ns, mesh, src, "hybrid")
         render_figure(compare_panels(mesh.vertices, mesh.faces, a.levels, **feat.tags()), fig)
         print(f"  comparison figure → {fig}")
+        written.append(fig)
     except ImportError:
         print("  (no comparison figure: it needs matplotlib — python -m pip install 'hybridsub[plot]')")
-    print(f"wrote {len(written) + os.path.exists(fig)} files to {os.path.abspath(a.output)}; creases and "
+    print(f"wrote {len(written)} files to {os.path.abspath(a.output)}; creases and "
           "corners are kept as OBJ tags ('t crease', 't corner')")
     return 0
 

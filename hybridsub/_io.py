@@ -54,6 +54,14 @@ class TaggedMesh:
     notes : tuple of str
         What the reader did that a user should know (tags it could not use, vertices it
         welded, polygons it triangulated).
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> m = hybridsub.TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), uv=np.eye(3)[:, :2],
+    ...                          face_uv=np.array([[0, 1, 2]]))
+    >>> m.has_tags, m.vertex_uv.tolist()
+    (False, [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
     """
 
     vertices: np.ndarray
@@ -720,7 +728,7 @@ def _rows(prefix: str, A: np.ndarray, fmt: str) -> list[str]:
 def _write_obj(path: str, m: TaggedMesh) -> None:
     from . import __version__
 
-    parts = [f"# hybridsub {__version__}: {len(m.vertices)} vertices, {len(m.faces)} triangles"
+    parts = [f"# hybridsub {__version__}: {len(m.vertices):,} vertices, {len(m.faces):,} triangles"
              + (f"; {describe_tags(m)}" if m.has_tags else "") + "\n",
              "# tags: OpenSubdiv's convention, 0-based vertex indices, sharpness 10 = infinitely sharp\n"]
     if m.vertex_colors is not None:
