@@ -548,6 +548,9 @@ def main(argv=None) -> int:
         return a.func(a)
     except CLIError as e:
         msg = str(e)
+    except BrokenPipeError:  # `hybridsub info big.ply | head`: the reader left, nothing to report
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except OSError as e:  # FileNotFoundError from read_mesh carries its message; the OS's carry a filename
         msg = f"{e.filename}: {e.strerror}" if e.filename and e.strerror else str(e)
     except (MeshError, ValueError, TypeError, ImportError) as e:
