@@ -14,10 +14,12 @@ True
 from ._errors import MeshError
 from ._examples import load_example
 from ._features import Features, detect_features
+from ._interop import subdivide_mesh
+from ._io import TaggedMesh, read_mesh, write_mesh
 from ._refine import Refinement, RefinementStep, refine, subdivide
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
-    "load_example",
+    "load_example", "subdivide_mesh", "read_mesh", "write_mesh", "TaggedMesh",
 ]
 __version__ = "0.1.0"
