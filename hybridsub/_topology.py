@@ -121,11 +121,15 @@ def plan_step(
     scheme: str,
     step: int,
     loop_weights: str,
+    force_split: np.ndarray | None = None,
 ) -> StepPlan:
     """Classify edges and vertices of one step and lay out the new points.
 
     ``edge_sharpness`` (ne,) holds the tagged sharpness per edge (0 = untagged), ``face_sharp``
-    (m,) the sharp-face mask, ``corner`` (n,) the corner mask.
+    (m,) the sharp-face mask, ``corner`` (n,) the corner mask. ``force_split`` (ne,) bool,
+    optional, marks edges that must be split although they would be flipped (UV seams, see
+    ``_facevarying``): they get an R4 edge point like a split-smooth edge and are not creases,
+    so vertex rules are unchanged. ``"hybrid"`` and ``"loop"`` only.
     """
     n, m = level.n_vertices, level.n_faces
     boundary = level.boundary_edge
@@ -136,6 +140,8 @@ def plan_step(
     bnext = bprev = empty
 
     if scheme == "sqrt3":
+        if force_split is not None and np.any(force_split):
+            raise ValueError('forced splits need scheme="hybrid" or "loop"; Kobbelt\'s √3 has no split edges')
         odd = step % 2 == 1
         face_sharp = np.zeros(m, dtype=bool)
         esharp = np.where(boundary, np.inf, 0.0)
@@ -153,7 +159,10 @@ def plan_step(
         f0 = owner // 3
         t = twin[owner]
         sharp_side = face_sharp[f0] | np.where(t >= 0, face_sharp[np.maximum(t, 0) // 3], False)
-        kind = np.where((esharp > 0) | sharp_side, R.EDGE_SPLIT, R.EDGE_FLIP).astype(np.int8)
+        split = (esharp > 0) | sharp_side
+        if force_split is not None:
+            split |= force_split
+        kind = np.where(split, R.EDGE_SPLIT, R.EDGE_FLIP).astype(np.int8)
         crease_mask = R.CREASE_MASK
         has_fp = ~face_sharp
 
