@@ -13,11 +13,12 @@ True
 
 from ._errors import MeshError
 from ._examples import load_example
+from ._facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from ._features import Features, detect_features
 from ._refine import Refinement, RefinementStep, refine, subdivide
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
-    "load_example",
+    "load_example", "subdivide_face_varying", "refine_face_varying", "FaceVaryingRefinement", "seam_edges",
 ]
 __version__ = "0.1.0"
