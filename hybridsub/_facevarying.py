@@ -17,7 +17,8 @@ refined ``FUV'`` stays aligned face by face with ``F'``:
 ``uv_mode="linear"``: old values stay, edge points are midpoints, face points centroids.
 ``uv_mode="smooth"``: the scheme's rules on the UV index mesh, its boundary as creases,
 geometric creases and corners carried onto it; a UV index used by several separate face
-sectors (or by several geometric vertices) is kept as one value and made a UV corner.
+sectors, by several geometric vertices or at a bow-tie vertex is kept as one value and made
+a UV corner.
 See ``docs/face_varying.md``.
 """
 
@@ -53,7 +54,8 @@ class FaceVaryingRefinement(NamedTuple):
         data, ``uv.matrix`` is the composite UV matrix. ``uv.sharp_edges``/``uv.sharpness``
         are the geometric creases carried onto the UV index mesh (as UV index pairs, each side
         of a seam listed), ``uv.corners`` the UV indices kept as corners in ``"smooth"`` mode
-        (carried corner tags, and UV indices shared by separate sectors or vertices).
+        (carried corner tags, and UV indices shared by separate sectors or vertices, or at bow-tie
+        vertices).
     """
 
     geometry: Refinement
@@ -163,7 +165,7 @@ def refine_face_varying(F, FUV, sharp_edges=None, levels=1, *, n_vertices=None, 
     level = build_level(Fi, n)
     uvl, seam = _uv_level(level, T, t)
     uv_corner = _carried_corners(level, uvl, corner)
-    uv_corners_out = np.flatnonzero(uv_corner | _shared_uv(level, uvl))
+    uv_corners_out = np.flatnonzero(uv_corner | _irregular_uv(level, uvl))
     _tagged(level, pairs, sharp, 1)  # names a tagged pair that is not an edge
     uv_pairs, uv_sharp = _uv_creases(level, uvl, pairs, sharp)
     for step in range(1, levels + 1):
@@ -178,7 +180,7 @@ def refine_face_varying(F, FUV, sharp_edges=None, levels=1, *, n_vertices=None, 
         # as creases, geometric creases and corners carried onto it.
         uv_tagged = tagged[level.edge_of[uvl.edge_owner]]
         uv_split = plan.kind[level.edge_of[uvl.edge_owner]] == R.EDGE_SPLIT
-        uv_fixed = uv_corner | _shared_uv(level, uvl)
+        uv_fixed = uv_corner | _irregular_uv(level, uvl)
         uv_plan = plan_step(uvl, uv_tagged, face_sharp, uv_fixed, scheme, step, loop_weights, force_split=uv_split)
         if not np.array_equal(uv_plan.kind, np.where(uv_split, R.EDGE_SPLIT, R.EDGE_FLIP)):
             raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
@@ -303,19 +305,24 @@ def _uv_level(level: Level, T: np.ndarray, t: int) -> tuple[Level, np.ndarray]:
     return Level(T, int(t), twin, by_origin, origin_start, edge_of, owner, ve_start, ve_edges), seam
 
 
-def _shared_uv(level: Level, uvl: Level) -> np.ndarray:
-    """(t,) bool: UV indices that cannot be one smooth value.
+def _irregular_uv(level: Level, uvl: Level) -> np.ndarray:
+    """(t,) bool: UV indices that cannot be one smooth value, kept as UV corners.
 
     A UV index used by several separate face sectors around a vertex (more than one UV
-    boundary halfedge leaves it), or by several geometric vertices (which includes a face
-    repeating a UV index).
+    boundary halfedge leaves it), by several geometric vertices (which includes a face
+    repeating a UV index), or at a vertex where several fans meet (a bow-tie, a corner of the
+    geometry; OpenSubdiv sharpens every face-varying value there too).
     """
-    t = uvl.n_vertices
+    t, n = uvl.n_vertices, max(level.n_vertices, 1)
     o = uvl.faces.ravel()
-    fans = np.bincount(o[uvl.twin < 0], minlength=t)
-    pairs = np.unique(o * np.int64(max(level.n_vertices, 1)) + level.faces.ravel())
-    users = np.bincount(pairs // max(level.n_vertices, 1), minlength=t)
-    return (fans > 1) | (users > 1)
+    fv = level.faces.ravel()
+    uv_fans = np.bincount(o[uvl.twin < 0], minlength=t)
+    pairs = np.unique(o * np.int64(n) + fv)
+    users = np.bincount(pairs // n, minlength=t)
+    bowtie = np.bincount(fv[level.twin < 0], minlength=level.n_vertices) > 1
+    out = (uv_fans > 1) | (users > 1)
+    out[o[bowtie[fv]]] = True
+    return out
 
 
 def _carried_corners(level: Level, uvl: Level, corner: np.ndarray) -> np.ndarray:

@@ -107,12 +107,15 @@ def uv_from_cuts(F, cuts, rng):
 @pytest.fixture(scope="module")
 def icosa_uv(mesh):
     V, F = mesh("icosahedron")
-    # a seam path through four vertices and a loop-free cut: like a UV chart boundary
-    E = {tuple(sorted(e)) for f in F.tolist() for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    # cut along a path of four edges, as a UV chart boundary would run
+    nbrs = {v: set() for v in range(len(V))}
+    for f in F.tolist():
+        for i in range(3):
+            nbrs[f[i]].add(f[(i + 1) % 3])
+            nbrs[f[(i + 1) % 3]].add(f[i])
     path = [0]
     while len(path) < 5:
-        nxt = min(b if a == path[-1] else a for a, b in E if path[-1] in (a, b) and not ({a, b} - {path[-1]}) <= set(path))
-        path.append(nxt)
+        path.append(min(nbrs[path[-1]] - set(path)))
     cuts = list(zip(path[:-1], path[1:]))
     UV, FUV = uv_from_cuts(F, cuts, np.random.default_rng(1))
     assert seam_count(F, FUV) >= 2
@@ -299,6 +302,16 @@ def test_uv_index_on_several_vertices_and_degenerate_uv_face():
         assert np.array_equal(UV2[0], UV[0]) and np.isfinite(UV2).all()
         kids = hybridsub.refine_face_varying(F, FUV, levels=2).uv.face_parent == 2
         assert np.allclose(UV2[FUV2[kids]], UV[0], atol=TOL, rtol=0)  # the whole face stays on it
+
+
+def test_uv_at_a_bowtie_vertex_is_a_uv_corner():
+    """Where two fans of the geometry meet (a corner of the geometry), every UV value stays."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0], [0, 1, 1], [0, -1, 1]])
+    F = np.array([[0, 1, 2], [0, 2, 5], [0, 3, 4], [0, 4, 6]])
+    FUV = np.array([[0, 1, 2], [0, 2, 5], [3, 4, 6], [3, 6, 7]])  # one UV index per fan at vertex 0
+    UV = np.random.default_rng(5).random((8, 2))
+    V2, _, UV2, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, uv_mode="smooth")
+    assert np.array_equal(V2[0], V[0]) and np.array_equal(UV2[[0, 3]], UV[[0, 3]])
 
 
 def test_matrices_and_refinements(icosa_uv):
