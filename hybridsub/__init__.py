@@ -13,6 +13,7 @@ True
 
 from ._errors import MeshError
 from ._examples import load_example
+from ._facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from ._features import Features, detect_features
 from ._interop import subdivide_mesh
 from ._io import TaggedMesh, read_mesh, write_mesh
@@ -20,6 +21,7 @@ from ._refine import Refinement, RefinementStep, refine, subdivide
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
-    "load_example", "subdivide_mesh", "read_mesh", "write_mesh", "TaggedMesh",
+    "load_example", "subdivide_mesh", "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying",
+    "refine_face_varying", "FaceVaryingRefinement", "seam_edges",
 ]
 __version__ = "0.1.0"

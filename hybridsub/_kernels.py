@@ -244,11 +244,12 @@ def _sharpness(h, twin, hsharp, has_tags):
 
 
 @njit(cache=True)
-def classify_step(F, twin, hsharp, has_tags, face_sharp, scheme, odd, hkind, edge_point, face_point,
-                  trisected, counts, s_frac):
+def classify_step(F, twin, hsharp, has_tags, face_sharp, force_split, scheme, odd, hkind, edge_point,
+                  face_point, trisected, counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
 
-    Fills ``hkind`` and ``edge_point`` (3m,): each halfedge's edge kind and the index of the
+    ``force_split`` (3m,) bool, or empty: edges to split even between smooth faces (UV
+    seams). Fills ``hkind`` and ``edge_point`` (3m,): each halfedge's edge kind and the index of the
     (first) point on its edge or −1; ``face_point`` (m,) likewise; ``trisected`` (m,) the
     local index of a face's trisected boundary halfedge or −1. ``counts`` (6, n), zeroed
     by the caller, receives per vertex: valence, incident edges with s > 0, with s > 1, with
@@ -271,7 +272,8 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, scheme, odd, hkind, edg
                 k = EDGE_KEEP if odd else EDGE_TRISECT
             else:
                 k = EDGE_FLIP
-        elif s > 0.0 or face_sharp[h // 3] or (t >= 0 and face_sharp[t // 3]):
+        elif (s > 0.0 or face_sharp[h // 3] or (t >= 0 and face_sharp[t // 3])
+              or (force_split.shape[0] > 0 and force_split[h])):
             k = EDGE_SPLIT
         else:
             k = EDGE_FLIP

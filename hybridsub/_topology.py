@@ -180,8 +180,12 @@ class StepPlan:
     bprev: np.ndarray
 
 
-def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_weights: str) -> StepPlan:
+def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_weights: str,
+              force_split: np.ndarray | None = None) -> StepPlan:
     """Classify edges and vertices of one step and lay out the new points.
+
+    ``force_split`` (3m,) bool marks halfedges whose edges are split even between smooth
+    faces (UV seams: R4 points, no flip); both halfedges of an edge must agree.
 
     Tags come from the level (``hsharp``, ``face_sharp``: all sharp for ``"loop"``, none for
     ``"sqrt3"``); ``corner`` (n,) is the corner mask.
@@ -197,7 +201,10 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     trisected = np.empty(m, np.int8)
     counts = np.zeros((6, n), np.int64)
     s_frac = np.zeros(n, np.float64)
-    n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp,
+    if force_split is not None and sqrt3:
+        raise ValueError('scheme="sqrt3" flips every interior edge; forced splits need "hybrid" or "loop"')
+    force = _EMPTY_B if force_split is None else np.ascontiguousarray(force_split, dtype=bool)
+    n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp, force,
                             R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts,
                             s_frac)
     table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
@@ -214,6 +221,7 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
 
 _EMPTY_F = np.empty(0, np.float64)
 _EMPTY_I = np.empty(0, np.int64)
+_EMPTY_B = np.empty(0, np.bool_)
 
 
 def step_arguments(level: Level, plan: StepPlan) -> tuple:

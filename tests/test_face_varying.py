@@ -1,0 +1,353 @@
+"""Face-varying data (UVs with seams): subdivide_face_varying / refine_face_varying.
+
+Against OpenSubdiv 3.5 (Loop, FVAR_LINEAR_ALL / FVAR_LINEAR_NONE) on a real textured scan
+(tests/data/bunny10k_textured.fvar_*.npz, see ../shared/reference/README.md): faces are
+matched as for the other references, then the UV value at each face corner is compared.
+Plus small hand-built cases for the rules of docs/face_varying.md.
+"""
+
+import os
+
+import numpy as np
+import pytest
+
+import hybridsub
+from meshcompare import match_vertices, mesh_difference
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+TOL = 1e-12
+
+
+def _load(mode, levels):
+    return np.load(os.path.join(DATA, f"bunny10k_textured.fvar_{mode}.L{levels}.npz"))
+
+
+def _canonical_corners(G, T):
+    """Rotate each triangle so its smallest vertex comes first, sort; carry T along."""
+    r = np.argmin(G, axis=1)
+    rows = np.arange(len(G))
+    Gc = np.stack([G[rows, (r + k) % 3] for k in range(3)], axis=1)
+    Tc = np.stack([T[rows, (r + k) % 3] for k in range(3)], axis=1)
+    o = np.lexsort(Gc.T[::-1])
+    return Gc[o], Tc[o]
+
+
+def corner_differences(V, F, UV, FUV, d):
+    """Per face corner: (bool (m, 3) 'UV differs from the reference', our UV index there)."""
+    idx, _ = match_vertices(V, d["V"])
+    G1, T1 = _canonical_corners(idx[F], FUV)
+    G2, T2 = _canonical_corners(d["F"], d["FUV"])
+    assert np.array_equal(G1, G2), "faces differ from the reference"
+    return np.abs(UV[T1] - d["UV"][T2]).max(axis=2) > TOL, T1
+
+
+def uv_boundary_halfedges(F, FUV):
+    """(3m,) bool, computed independently of hybridsub: halfedges with no twin, or whose twin
+    face has other UV indices at the edge's ends (a seam)."""
+    F, FUV = np.asarray(F), np.asarray(FUV)
+    n = int(F.max()) + 1
+    a, b = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    ua, ub = FUV.ravel(), np.roll(FUV, -1, axis=1).ravel()
+    key = a * n + b
+    order = np.argsort(key)
+    pos = np.searchsorted(key[order], b * n + a)
+    pos = np.minimum(pos, len(key) - 1)
+    has = key[order][pos] == b * n + a
+    g = order[pos]
+    return ~has | (ua != ub[g]) | (ub != ua[g])
+
+
+def seam_count(F, FUV):
+    return int((uv_boundary_halfedges(F, FUV) & ~_geometric_boundary(F)).sum()) // 2
+
+
+def _geometric_boundary(F):
+    F = np.asarray(F)
+    he = np.stack([F.ravel(), np.roll(F, -1, axis=1).ravel()], axis=1)
+    fwd = {tuple(x) for x in he.tolist()}
+    return np.array([(b, a) not in fwd for a, b in he.tolist()])
+
+
+def shared_sector_uvs(F, FUV):
+    """UV indices with more than one UV boundary halfedge leaving them: several sectors."""
+    FUV = np.asarray(FUV)
+    leaving = np.bincount(FUV.ravel()[uv_boundary_halfedges(F, FUV)], minlength=int(FUV.max()) + 1)
+    return np.flatnonzero(leaving > 1)
+
+
+def uv_from_cuts(F, cuts, rng):
+    """A UV index mesh for F: one UV index per (vertex, sector), sectors cut along ``cuts``."""
+    F = np.asarray(F)
+    m = len(F)
+    parent = list(range(3 * m))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    cut = {frozenset(map(int, c)) for c in cuts}
+    he = {}
+    for f in range(m):
+        for i in range(3):
+            he[(int(F[f, i]), int(F[f, (i + 1) % 3]))] = (f, i)
+    for (a, b), (f, i) in he.items():
+        if (b, a) in he and frozenset((a, b)) not in cut:
+            g, j = he[(b, a)]
+            # corner of a in f is corner of a in g; corner of b likewise
+            for x, y in ((3 * f + i, 3 * g + (j + 1) % 3), (3 * f + (i + 1) % 3, 3 * g + j)):
+                parent[find(x)] = find(y)
+    roots = np.array([find(x) for x in range(3 * m)])
+    _, FUV = np.unique(roots, return_inverse=True)
+    FUV = FUV.reshape(m, 3)
+    return rng.random((int(FUV.max()) + 1, 2)), FUV
+
+
+@pytest.fixture(scope="module")
+def icosa_uv(mesh):
+    V, F = mesh("icosahedron")
+    # cut along a path of four edges, as a UV chart boundary would run
+    nbrs = {v: set() for v in range(len(V))}
+    for f in F.tolist():
+        for i in range(3):
+            nbrs[f[i]].add(f[(i + 1) % 3])
+            nbrs[f[(i + 1) % 3]].add(f[i])
+    path = [0]
+    while len(path) < 5:
+        path.append(min(nbrs[path[-1]] - set(path)))
+    cuts = list(zip(path[:-1], path[1:]))
+    UV, FUV = uv_from_cuts(F, cuts, np.random.default_rng(1))
+    assert seam_count(F, FUV) >= 2
+    return V, F, UV, FUV, cuts
+
+
+# --------------------------------------------------------------------------- OpenSubdiv
+@pytest.mark.parametrize("levels", [1, 2])
+def test_linear_matches_opensubdiv_at_every_corner(levels):
+    d = _load("linear", levels)
+    V, F, UV, FUV = hybridsub.subdivide_face_varying(d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"], levels=levels,
+                                                     scheme="loop", uv_mode="linear")
+    assert mesh_difference(V, F, d["V"], d["F"], TOL) is None
+    bad, _ = corner_differences(V, F, UV, FUV, d)
+    assert bad.sum() == 0
+
+
+@pytest.mark.parametrize("levels", [1, 2])
+def test_smooth_matches_opensubdiv_except_near_shared_sector_uvs(levels):
+    d = _load("smooth", levels)
+    geo, uv = hybridsub.refine_face_varying(d["F_in"], d["FUV_in"], levels=levels, scheme="loop", uv_mode="smooth")
+    V, UV = geo.apply(d["V_in"]), uv.apply(d["UV_in"])
+    assert mesh_difference(V, geo.faces, d["V"], d["F"], TOL) is None
+    bad, T = corner_differences(V, geo.faces, UV, uv.faces, d)
+    assert 0 < bad.sum() <= 0.001 * bad.size
+    # every differing value depends on a UV index shared by separate sectors (OpenSubdiv
+    # splits such a value per sector; hybridsub keeps it as a UV corner)
+    shared = shared_sector_uvs(d["F_in"], d["FUV_in"])
+    assert 0 < len(shared) < 0.02 * len(d["UV_in"])
+    near = np.asarray(abs(uv.matrix[:, shared]).sum(axis=1)).ravel() > 0
+    assert near[np.unique(T[bad])].all()
+    assert np.array_equal(UV[shared], d["UV_in"][shared])  # kept where they were
+
+
+def test_loop_geometry_is_plain_loop():
+    d = _load("linear", 2)
+    V, F, UV, FUV = hybridsub.subdivide_face_varying(d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"], levels=2,
+                                                     scheme="loop")
+    V0, F0 = hybridsub.subdivide(d["V_in"], d["F_in"], levels=2, scheme="loop")
+    assert np.array_equal(F, F0) and np.array_equal(V, V0)
+
+
+def test_bunny_index_mesh_is_what_the_docs_say():
+    """The UV index mesh of the real scan: each UV index on one vertex, seams cut it into a
+    valid (edge-manifold, oriented) mesh, and a few UV indices are shared by separate sectors."""
+    d = _load("linear", 1)
+    F, FUV = d["F_in"], d["FUV_in"]
+    pairs = np.unique(np.stack([FUV.ravel(), F.ravel()], 1), axis=0)
+    assert len(pairs) == len(d["UV_in"])  # one vertex per UV index, every UV used
+    seams = hybridsub.seam_edges(F, FUV)
+    assert len(seams) == seam_count(F, FUV) == 1289
+    assert len(shared_sector_uvs(F, FUV)) == 76
+
+
+# --------------------------------------------------------------------------- small cases
+SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0.5], [0, 1, 0]])
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+SQUARE_UV = np.array([[0.0, 0], [1, 0], [1, 1], [2, 0], [3, 1], [2, 1]])
+SQUARE_FUV = np.array([[0, 1, 2], [3, 4, 5]])  # two charts: the diagonal 0-2 is a seam
+
+
+def test_square_seam_is_split_not_flipped():
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(SQUARE_V, SQUARE_F, SQUARE_UV, SQUARE_FUV)
+    Vp, Fp = hybridsub.subdivide(SQUARE_V, SQUARE_F)
+    assert len(Vp) == 10 and len(V2) == 11  # plain hybrid flips the diagonal, here it is split
+    a, b, c, d = SQUARE_V
+    r4 = 3 / 8 * (a + c) + 1 / 8 * (b + d)
+    assert np.abs(V2 - r4).max(axis=1).min() < TOL
+    cf, cg = 9, 10  # face points come last, in face order
+    assert np.allclose(V2[[cf, cg]], [(a + b + c) / 3, (a + c + d) / 3], atol=TOL, rtol=0)
+    edges = {frozenset(e) for f in F2.tolist() for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    assert frozenset((cf, cg)) not in edges  # no triangle spans the seam
+    assert len(F2) == len(FUV2) == 12
+    # linear UVs: old values and midpoints of each chart's edges exactly, centroids (weights
+    # 1/3 each) to rounding
+    assert np.array_equal(UV2[:6], SQUARE_UV)
+    for f in range(2):
+        p, q, r = SQUARE_UV[SQUARE_FUV[f]]
+        for x in ((p + q) / 2, (q + r) / 2, (r + p) / 2):
+            assert np.abs(UV2 - x).max(axis=1).min() == 0
+        assert np.abs(UV2 - (p + q + r) / 3).max(axis=1).min() < TOL
+    assert len(UV2) == 6 + 6 + 2  # each side of the seam has its own edge point
+    # the seam's children are seams: two per side
+    assert len(hybridsub.seam_edges(F2, FUV2)) == 2
+
+
+def test_square_loop_geometry_and_uv_layout():
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(SQUARE_V, SQUARE_F, SQUARE_UV, SQUARE_FUV, scheme="loop")
+    V0, F0 = hybridsub.subdivide(SQUARE_V, SQUARE_F, scheme="loop")
+    assert np.array_equal(V2, V0) and np.array_equal(F2, F0)
+    assert len(UV2) == 6 + 6 and len(hybridsub.seam_edges(F2, FUV2)) == 2
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+@pytest.mark.parametrize("uv_mode", ["linear", "smooth"])
+def test_faces_stay_aligned(icosa_uv, scheme, uv_mode):
+    """Each output face's UV corners belong to its own corners: an input vertex keeps the UV
+    index its parent face gave it; every UV index sits on one vertex; face parents agree."""
+    V, F, UV, FUV, _ = icosa_uv
+    geo, uv = hybridsub.refine_face_varying(F, FUV, levels=3, scheme=scheme, uv_mode=uv_mode)
+    assert geo.faces.shape == uv.faces.shape
+    assert np.array_equal(geo.face_parent, uv.face_parent)
+    for gs, us in zip(geo.steps, uv.steps):
+        assert np.array_equal(gs.face_parent, us.face_parent)
+    G, T = geo.faces, uv.faces
+    pairs = np.unique(np.stack([T.ravel(), G.ravel()], 1), axis=0)
+    assert len(np.unique(pairs[:, 0])) == len(pairs) == uv.n_vertices  # one vertex per UV index
+    P = geo.face_parent
+    for k in range(3):
+        old = G[:, k] < len(V)
+        f, v, u = P[old], G[old, k], T[old, k]
+        hit = F[f] == v[:, None]
+        assert hit.sum(axis=1).tolist() == [1] * len(f)  # the vertex is a corner of the parent
+        assert np.array_equal(FUV[f][hit], u)  # with the parent's UV index there
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_uv_continuous_away_from_seams(icosa_uv, scheme):
+    """Seams' children are seams and no new seam appears: where the input has no seam, the
+    two sides of every output edge share their UV indices."""
+    V, F, UV, FUV, cuts = icosa_uv
+    s0 = seam_count(F, FUV)
+    for levels in (1, 2, 3):
+        V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=levels, scheme=scheme)
+        assert seam_count(F2, FUV2) == len(hybridsub.seam_edges(F2, FUV2)) == s0 * 2 ** levels
+    # and without seams there is no seam, and the UV index mesh is the mesh itself
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, V[:, :2], F, levels=2, scheme=scheme)
+    assert seam_count(F2, FUV2) == 0 and np.array_equal(F2, FUV2)
+
+
+def test_without_seams_smooth_uvs_are_the_geometry():
+    """FUV = F: the UV index mesh is the mesh, so "smooth" UVs follow the very rules of the
+    positions (creases, semi-sharp creases, sharp faces, corners carried onto it)."""
+    V, F = hybridsub.load_example()
+    feat = hybridsub.detect_features(V, F, angle=30)
+    creases = feat.sharp_edges
+    sharpness = np.where(np.arange(len(creases)) % 3 == 0, 1.5, np.inf)
+    kw = dict(sharpness=sharpness, sharp_faces=np.arange(0, len(F), 7), corners=feat.corners[:3])
+    V2, F2 = hybridsub.subdivide(V, F, creases, levels=2, **kw)
+    Vf, Ff, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, V, F, creases, levels=2, uv_mode="smooth", **kw)
+    assert np.array_equal(Ff, F2) and np.array_equal(FUV2, F2)
+    assert np.array_equal(Vf, V2) and np.array_equal(UV2, V2)
+    _, _, UVl, FUVl = hybridsub.subdivide_face_varying(V, F, V, F, creases, levels=1, **kw)
+    r = hybridsub.refine(F, creases, levels=1, **kw)
+    assert np.array_equal(FUVl, r.faces) and np.array_equal(UVl[: len(V)], V)
+
+
+def _fan(dart):
+    """Six triangles around vertex 0; spoke 0-1 is a seam, and spoke 0-4 too unless ``dart``."""
+    ang = np.arange(6) * np.pi / 3
+    V = np.c_[np.r_[0, np.cos(ang)], np.r_[0, np.sin(ang)], np.r_[0.3, np.zeros(6)]]
+    F = np.array([[0, i, i % 6 + 1] for i in range(1, 7)])
+    FUV = F.copy()
+    FUV[5, 2] = 7  # face (0, 6, 1) has its own UV index at vertex 1
+    if not dart:
+        FUV[3, 1] = 8  # face (0, 4, 5) has its own UV index at vertex 4
+    UV = np.random.default_rng(3).random((9, 2))
+    return V, F, UV, FUV
+
+
+def test_uv_shared_by_two_sectors_is_a_uv_corner():
+    V, F, UV, FUV = _fan(dart=False)
+    assert shared_sector_uvs(F, FUV).tolist() == [0]
+    for scheme in ("hybrid", "loop"):
+        _, _, UV2, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, scheme=scheme, uv_mode="smooth")
+        assert np.array_equal(UV2[0], UV[0])
+        assert 0 in hybridsub.refine_face_varying(F, FUV, scheme=scheme, uv_mode="smooth").uv.corners
+
+
+def test_uv_dart_is_a_uv_crease():
+    """A seam that ends at an interior vertex opens the UV index mesh there: B2 on its two sides."""
+    V, F, UV, FUV = _fan(dart=True)
+    assert shared_sector_uvs(F, FUV).tolist() == []
+    _, _, UV2, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, scheme="loop", uv_mode="smooth")
+    assert np.allclose(UV2[0], 3 / 4 * UV[0] + 1 / 8 * (UV[1] + UV[7]), atol=TOL, rtol=0)
+
+
+def test_uv_index_on_several_vertices_and_degenerate_uv_face():
+    """Real files reuse one UV index for unmapped corners: it stays one value and a UV corner."""
+    V, F, UV, FUV = _fan(dart=True)
+    FUV[2] = [0, 0, 0]  # a face without texture: all corners on UV 0
+    for uv_mode in ("linear", "smooth"):
+        V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, uv_mode=uv_mode)
+        assert np.array_equal(UV2[0], UV[0]) and np.isfinite(UV2).all()
+        kids = hybridsub.refine_face_varying(F, FUV, levels=2).uv.face_parent == 2
+        assert np.allclose(UV2[FUV2[kids]], UV[0], atol=TOL, rtol=0)  # the whole face stays on it
+
+
+def test_uv_at_a_bowtie_vertex_is_a_uv_corner():
+    """Where two fans of the geometry meet (a corner of the geometry), every UV value stays."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0], [0, 1, 1], [0, -1, 1]])
+    F = np.array([[0, 1, 2], [0, 2, 5], [0, 3, 4], [0, 4, 6]])
+    FUV = np.array([[0, 1, 2], [0, 2, 5], [3, 4, 6], [3, 6, 7]])  # one UV index per fan at vertex 0
+    UV = np.random.default_rng(5).random((8, 2))
+    V2, _, UV2, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, uv_mode="smooth")
+    assert np.array_equal(V2[0], V[0]) and np.array_equal(UV2[[0, 3]], UV[[0, 3]])
+
+
+def test_matrices_and_refinements(icosa_uv):
+    V, F, UV, FUV, cuts = icosa_uv
+    seams = {frozenset(p) for p in hybridsub.seam_edges(F, FUV).tolist()}
+    inner = [e for e in map(tuple, np.sort(F[:, :2], axis=1).tolist()) if frozenset(e) not in seams][:3]
+    creases = np.array(cuts[:2] + inner)  # on seams (UV boundary) and inside UV charts
+    V2, F2, UV2, FUV2, S, S_uv = hybridsub.subdivide_face_varying(V, F, UV, FUV, creases, levels=2,
+                                                                  uv_mode="smooth", return_matrix=True)
+    assert np.allclose(S @ V, V2, atol=TOL, rtol=0) and np.allclose(S_uv @ UV, UV2, atol=TOL, rtol=0)
+    assert np.allclose(S_uv.sum(axis=1), 1, atol=TOL, rtol=0) and S_uv.min() >= 0
+    r = hybridsub.refine_face_varying(F, FUV, creases, levels=2, uv_mode="smooth")
+    assert isinstance(r, hybridsub.FaceVaryingRefinement) and r.geometry is r[0] and r.uv is r[1]
+    assert np.array_equal(r.uv.faces, FUV2) and np.array_equal(r.geometry.faces, F2)
+    # creases carried onto the UV index mesh: those off the seams, each on a geometric crease
+    geo_pairs = {frozenset(p) for p in r.geometry.sharp_edges.tolist()}
+    fine_seams = {frozenset(p) for p in hybridsub.seam_edges(F2, FUV2).tolist()}
+    to_vertex = dict(zip(FUV2.ravel().tolist(), F2.ravel().tolist()))
+    uv_on_geo = {frozenset((to_vertex[a], to_vertex[b])) for a, b in r.uv.sharp_edges.tolist()}
+    assert uv_on_geo == geo_pairs - fine_seams and len(uv_on_geo) > 0 and len(geo_pairs & fine_seams) > 0
+    # levels=0: the input, copied
+    r0 = hybridsub.refine_face_varying(F, FUV, levels=0)
+    assert np.array_equal(r0.uv.faces, FUV) and r0.uv.faces is not FUV and r0.uv.n_vertices == len(UV)
+
+
+def test_errors():
+    V, F, UV, FUV = SQUARE_V, SQUARE_F, SQUARE_UV, SQUARE_FUV
+    with pytest.raises(ValueError, match='"hybrid"'):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV, scheme="sqrt3")
+    with pytest.raises(ValueError, match="uv_mode"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV, uv_mode="cubic")
+    with pytest.raises(hybridsub.MeshError, match="FUV must have shape"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV[:1])
+    with pytest.raises(hybridsub.MeshError, match="only 5 UV values"):
+        hybridsub.subdivide_face_varying(V, F, UV[:5], FUV)
+    with pytest.raises(TypeError, match="FUV must hold integer"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV + 0.5)
+    with pytest.raises(hybridsub.MeshError, match="not an edge"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV, [[1, 3]])
