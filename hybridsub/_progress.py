@@ -1,14 +1,8 @@
 """Refinement level by level, with a progress bar on stderr.
 
-``refine`` runs all its levels in one call and keeps every step's matrix. The command line
-instead refines one level at a time, applies that step to the positions (and colours, UVs)
-at once and drops it, so it can report each level as it finishes and never holds more than
-two levels. Calling ``refine(levels=1)`` repeatedly, carrying the propagated tags, is the
-same computation as one call with ``"hybrid"`` and ``"loop"`` (a step depends only on the
-level's faces and tags) and with ``"sqrt3"`` on closed meshes. Kobbelt's boundary rule counts
-odd and even steps within a call, so on open meshes ``"sqrt3"`` goes two levels per call
-(odd, even), which keeps the parity. ``tests/test_cli.py`` checks all of this against single
-calls.
+The command line refines with :func:`hybridsub._refine.subdivide_levels`, the fast path of
+``subdivide``, which yields each level as it is done with its propagated tags: the bar moves
+per level, only two levels are held at a time, and no matrix is formed.
 """
 
 from __future__ import annotations
@@ -20,8 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._meshinfo import _edges
-from ._refine import refine
+from ._refine import subdivide_levels
 
 
 @dataclass
@@ -40,45 +33,34 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
                     corners=None, loop_weights="loop", on_level=None) -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
-    ``on_level(done, levels, n_faces, seconds)`` is called after each call to ``refine`` (one
-    level, or two for ``"sqrt3"`` on an open mesh).
+    ``on_level(done, levels, n_faces, seconds)`` is called after each level.
     """
-    X = np.asarray(X, dtype=np.float64)
+    X = np.ascontiguousarray(X, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
-    n = len(X)
-    chunk = 1
-    if scheme == "sqrt3" and levels > 1 and len(F) and (_edges(F, n)[2] == 1).any():
-        chunk = 2
-    if sharp_faces is not None:
-        mask = np.zeros(len(F), bool)
-        mask[np.asarray(sharp_faces)] = True
-        sharp_faces = mask
     parent = np.arange(len(F), dtype=np.int64)
-    done, total = 0, 0.0
-    while done < levels:
-        k = min(chunk, levels - done)
-        t = time.perf_counter()
-        r = refine(F, sharp_edges, k, n_vertices=n, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
-                   corners=corners, loop_weights=loop_weights)
-        X = r.apply(X)
-        F, sharp_edges, sharpness, sharp_faces, corners = r.faces, r.sharp_edges, r.sharpness, r.sharp_faces, r.corners
-        parent = parent[r.face_parent]
-        n = r.n_vertices
-        del r
+    pairs, sharp = sharp_edges, sharpness
+    mask = None
+    total = 0.0
+    t = time.perf_counter()
+    for out in subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
+                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights):
+        X, F, pairs, sharp, mask = out.X, out.faces, out.sharp_edges, out.sharpness, out.sharp_faces
+        parent = parent[out.face_parent]
         dt = time.perf_counter() - t
         total += dt
-        done += k
         if on_level is not None:
-            on_level(done, levels, len(F), dt)
-    if sharp_faces is None:
-        sharp_faces = np.zeros(len(F), bool)
-    if sharp_edges is None:
-        sharp_edges, sharpness = np.empty((0, 2), np.int64), np.empty(0)
+            on_level(out.step, levels, len(F), dt)
+        t = time.perf_counter()
+    if mask is None:  # no step ran: the input's tags
+        mask = np.zeros(len(F), bool)
+        if sharp_faces is not None:
+            mask[np.asarray(sharp_faces)] = True
+    if pairs is None:
+        pairs, sharp = np.empty((0, 2), np.int64), np.empty(0)
+    if sharp is None:
+        sharp = np.full(len(pairs), np.inf)
     corners = np.empty(0, np.int64) if corners is None else np.asarray(corners, dtype=np.int64)
-    if sharpness is None:
-        sharpness = np.full(len(sharp_edges), np.inf)
-    return LevelResult(X, F, np.asarray(sharp_edges), np.asarray(sharpness), np.asarray(sharp_faces), corners,
-                       parent, total)
+    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total)
 
 
 def _si(x: float) -> str:

@@ -283,12 +283,45 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
         r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
         return r.apply(Vf).astype(out_dtype, copy=False), r.faces, r.matrix
-    levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
-        F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
-    X, faces = Vf, Fi
-    for level, plan, faces, _, _ in _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights,
-                                          topology_last=False):
-        X = apply_step(level, plan, X)
-    if X is Vf:
-        X, faces = Vf.copy(), Fi.copy()
+    X, faces = Vf.copy(), np.asarray(F)
+    for out in subdivide_levels(Vf, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
+                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False):
+        X, faces = out.X, out.faces
+    if faces is F or levels == 0:
+        faces = val.as_faces(F, len(Vf))[0].copy()
     return X.astype(out_dtype, copy=False), faces
+
+
+@dataclass(frozen=True, eq=False)
+class LevelOutput:
+    """One level of :func:`subdivide_levels`."""
+
+    step: int
+    X: np.ndarray  # (n_k, d) refined data
+    faces: np.ndarray  # (m_k, 3)
+    face_parent: np.ndarray  # (m_k,) face of the previous level each face came from
+    sharp_edges: np.ndarray | None  # tags of this level (None unless tags=True)
+    sharpness: np.ndarray | None
+    sharp_faces: np.ndarray | None  # (m_k,) bool mask
+
+
+def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
+                     corners=None, loop_weights="loop", tags=True):
+    """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
+
+    The fast path behind :func:`subdivide`, for callers that want each level as it is done
+    (the command line's progress bar) or the propagated tags with the positions. ``X`` is
+    any (n, d) per-vertex data, already validated as float64. With ``tags=False`` the last
+    level's tags are not computed (nor its twins).
+    """
+    n = len(X)
+    levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
+        F, sharp_edges, levels, n, scheme, sharpness, sharp_faces, corners, loop_weights)
+    for k, (level, plan, faces, child, offsets) in enumerate(
+            _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last=tags), 1):
+        X = apply_step(level, plan, X)
+        if tags:
+            pairs, sharp = child_creases(level, plan)
+            yield LevelOutput(k, X, faces, face_parents(offsets), pairs, sharp, child.face_sharp)
+        else:
+            yield LevelOutput(k, X, faces, face_parents(offsets), None, None, None)
