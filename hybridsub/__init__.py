@@ -11,7 +11,8 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 True
 """
 
-from ._errors import MeshError
+from ._budget import get_memory_limit, set_memory_limit
+from ._errors import MeshError, OutputTooLargeError
 from ._examples import load_example
 from ._features import Features, detect_features
 from ._interop import subdivide_mesh
@@ -20,6 +21,7 @@ from ._refine import Refinement, RefinementStep, refine, subdivide
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
-    "load_example", "subdivide_mesh", "read_mesh", "write_mesh", "TaggedMesh",
+    "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
+    "read_mesh", "write_mesh", "TaggedMesh",
 ]
 __version__ = "0.1.0"
