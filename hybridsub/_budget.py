@@ -268,7 +268,8 @@ class Budget:
         todo = self.levels - step + 1
         suggestion = _suggest(est.bytes)
         return (
-            f"{start} {level.n_faces:,} faces by {todo} more level{'s' if todo != 1 else ''} "
+            f"{start} {level.n_faces:,} faces by {todo} {'more ' if step > 1 else ''}"
+            f"level{'s' if todo != 1 else ''} "
             f"(scheme {self.scheme!r}) would make about {est.faces:,} faces and {est.vertices:,} vertices "
             f"and need about {_both(est.bytes)} of memory (estimated before allocating), "
             f"more than the limit of {_both(self.limit)} set by "

@@ -127,20 +127,20 @@ def cut_non_manifold(F: np.ndarray, n: int, crease_vertices: np.ndarray | None =
     origin = np.concatenate([np.arange(n, dtype=np.int64), kv[extra]])
     Fc = new_v.reshape(m, 3)
 
-    corner = _sharpen(Fc, u, w, group, he_cut, bad_group, on_cut, origin, n, crease_vertices)
+    corner = _sharpen(Fc, u, w, a, group, he_cut, bad_group, on_cut, origin, n, crease_vertices)
     lo, hi = np.minimum(u[a[bad_group]], w[a[bad_group]]), np.maximum(u[a[bad_group]], w[a[bad_group]])
     return Cut(np.ascontiguousarray(Fc), origin, np.stack([lo, hi], axis=1), corner, he_cut)
 
 
-def _sharpen(Fc, u, w, group, he_cut, bad_group, on_cut, origin, n, crease_vertices):
-    """Corner mask of the cut mesh: copies of cut vertices that must not move (see module doc)."""
+def _sharpen(Fc, u, w, first_he, group, he_cut, bad_group, on_cut, origin, n, crease_vertices):
+    """Corner mask of the cut mesh: copies of cut vertices that must not move (see module doc).
+
+    ``first_he`` is the lowest halfedge of each edge group of the input.
+    """
     n_cut = origin.shape[0]
     # number of distinct cut edges at each input vertex
-    bad_ids = np.flatnonzero(bad_group)
-    first_he = np.full(len(bad_group), -1, np.int64)
-    first_he[group[::-1]] = np.arange(len(group))[::-1]  # lowest halfedge of each group
-    eu, ew = u[first_he[bad_ids]], w[first_he[bad_ids]]
-    n_bad = np.bincount(np.concatenate([eu, ew]), minlength=n)
+    bad_he = first_he[bad_group]
+    n_bad = np.bincount(np.concatenate([u[bad_he], w[bad_he]]), minlength=n)
 
     # boundary edges of the cut mesh, at each copy: how many, and how many are cut edges
     cu = Fc.ravel()

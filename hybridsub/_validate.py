@@ -212,7 +212,11 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
         if s.shape != (len(E),):
             raise MeshError(f"sharpness must have one value per sharp edge ({len(E)}), got {s.shape[0]}")
         if np.isnan(s).any():
-            raise MeshError(f"sharpness {int(np.flatnonzero(np.isnan(s))[0])} is NaN")
+            j = int(np.flatnonzero(np.isnan(s))[0])
+            raise MeshError(
+                f"sharpness {j} (of sharp edge {E[j].tolist()}) is NaN; give a number: > 0 for a crease "
+                "(>= 10 or inf: infinitely sharp), <= 0 for none"
+            )
         s = R.normalize_sharpness(s)
     return E, s
 
