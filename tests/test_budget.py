@@ -91,7 +91,7 @@ def test_refused_before_allocating(monkeypatch):
     e = ei.value
     assert isinstance(e, MemoryError) and isinstance(e, ValueError)
     msg = str(e)
-    assert "refining 12,946 faces by 9 more levels (scheme 'hybrid')" in msg
+    assert "refining 12,946 faces by 9 levels (scheme 'hybrid')" in msg
     assert "16.0 GB (16,000,000,000 bytes) set by max_memory" in msg
     for part in ("would make about", "faces and", "vertices and need about", "of memory", "fewer levels",
                  "max_memory=", "hybridsub.set_memory_limit(", "HYBRIDSUB_MAX_MEMORY=", "'none' turns the check off"):
