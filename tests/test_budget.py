@@ -86,6 +86,9 @@ def test_refused_before_allocating(monkeypatch):
         raise AssertionError("a step matrix was built although the budget refused")
 
     monkeypatch.setattr(hybridsub._refine, "step_matrix", no)
+    monkeypatch.setattr(hybridsub._refine, "apply_step", no)
+    with pytest.raises(OutputTooLargeError, match="set by max_memory"):
+        hybridsub.refine(F, levels=9, max_memory="16G")
     with pytest.raises(OutputTooLargeError) as ei:
         hybridsub.subdivide(V, F, levels=9, max_memory="16G")
     e = ei.value
@@ -96,6 +99,21 @@ def test_refused_before_allocating(monkeypatch):
     for part in ("would make about", "faces and", "vertices and need about", "of memory", "fewer levels",
                  "max_memory=", "hybridsub.set_memory_limit(", "HYBRIDSUB_MAX_MEMORY=", "'none' turns the check off"):
         assert part in msg
+
+
+def test_subdivide_keeps_one_level_at_a_time():
+    V, F = hybridsub.load_example()
+    keep = predicted(F, 3, "hybrid")
+    one = predicted(F, 3, "hybrid", keeps_steps=False)
+    assert (one.faces, one.vertices) == (keep.faces, keep.vertices) and one.bytes < keep.bytes
+    # subdivide (no matrices kept) fits where refine (every step kept) does not
+    limit = (one.bytes + keep.bytes) / 2
+    V2, F2 = hybridsub.subdivide(V, F, levels=3, max_memory=limit)
+    assert len(F2) == one.faces
+    with pytest.raises(OutputTooLargeError):
+        hybridsub.refine(F, levels=3, max_memory=limit)
+    with pytest.raises(OutputTooLargeError):
+        hybridsub.subdivide(V, F, levels=3, max_memory=limit, return_matrix=True)
 
 
 def test_message_numbers_are_the_estimate():

@@ -341,7 +341,7 @@ def test_sharp_edges_float_holding_integers_is_fine():
 
 @pytest.mark.parametrize("s, err, match", [
     ([1.0, 2.0], MeshError, r"sharpness must have one value per sharp edge \(1\), got 2"),
-    ([np.nan], MeshError, "sharpness 0 is NaN"),
+    ([np.nan], MeshError, r"sharpness 0 \(of sharp edge \[0, 2\]\) is NaN; give a number"),
     (["x"], TypeError, "sharpness must be real numbers"),
     ([1j], TypeError, "sharpness must be real numbers"),
 ])
