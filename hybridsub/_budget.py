@@ -5,7 +5,8 @@ The limit, in bytes, is taken from (first found):
 1. the ``max_memory=`` argument of ``refine`` / ``subdivide``;
 2. :func:`set_memory_limit`;
 3. the environment variable ``HYBRIDSUB_MAX_MEMORY`` (read at every call);
-4. half of the machine's physical memory (8 GiB where that cannot be read).
+4. 80 % of the machine's physical memory (8 GiB where that cannot be read) — the threshold
+   the command line's own check uses; the estimate errs high, so this is not a tight fit.
 
 A limit is a number of bytes, or a string such as ``"16G"``, ``"16GB"`` (10⁹), ``"16GiB"``
 (2³⁰), ``"1.5e10"``; ``inf`` or ``"none"`` turns the check off.
@@ -33,7 +34,7 @@ from . import _stencils
 from ._errors import OutputTooLargeError
 
 ENV_VAR = "HYBRIDSUB_MAX_MEMORY"
-DEFAULT_FRACTION = 0.5
+DEFAULT_FRACTION = 0.8
 FALLBACK_LIMIT = 8 * 2**30
 
 _limit: float | None = None  # set by set_memory_limit; None: environment or default
@@ -82,7 +83,7 @@ def set_memory_limit(limit) -> None:
     limit : int, float, str or None
         Bytes (``inf``: no limit), or a string such as ``"16G"`` (10⁹ bytes), ``"16GiB"``
         (2³⁰ bytes) or ``"none"``. ``None`` restores the default: the environment variable
-        ``HYBRIDSUB_MAX_MEMORY`` if set, else half of the physical memory.
+        ``HYBRIDSUB_MAX_MEMORY`` if set, else 80 % of the physical memory.
 
     Examples
     --------
@@ -101,7 +102,7 @@ def get_memory_limit(max_memory=None) -> float:
 
     ``max_memory`` (a per-call value, as ``refine`` takes it) wins over
     :func:`set_memory_limit`, which wins over ``HYBRIDSUB_MAX_MEMORY``, which wins over the
-    default (half of the physical memory).
+    default (80 % of the physical memory).
     """
     limit, _ = _resolve(max_memory)
     return limit
@@ -119,7 +120,7 @@ def _resolve(max_memory) -> tuple[float, str]:
     phys = physical_memory()
     if phys is None:  # pragma: no cover - platform dependent
         return float(FALLBACK_LIMIT), "the default (8 GiB: the physical memory could not be read)"
-    return DEFAULT_FRACTION * phys, f"the default (half of this machine's {fmt_bytes(phys)} of RAM)"
+    return DEFAULT_FRACTION * phys, f"the default (80 % of this machine's {fmt_bytes(phys)} of RAM)"
 
 
 def _both(x: float) -> str:

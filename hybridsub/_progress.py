@@ -37,11 +37,11 @@ class LevelResult:
 
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
-                    corners=None, loop_weights="loop", on_level=None) -> LevelResult:
+                    corners=None, loop_weights="loop", on_level=None, max_memory=None) -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each call to ``refine`` (one
-    level, or two for ``"sqrt3"`` on an open mesh).
+    level, or two for ``"sqrt3"`` on an open mesh). ``max_memory`` goes to every ``refine``.
     """
     X = np.asarray(X, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
@@ -59,7 +59,7 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         k = min(chunk, levels - done)
         t = time.perf_counter()
         r = refine(F, sharp_edges, k, n_vertices=n, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
-                   corners=corners, loop_weights=loop_weights)
+                   corners=corners, loop_weights=loop_weights, max_memory=max_memory)
         X = r.apply(X)
         F, sharp_edges, sharpness, sharp_faces, corners = r.faces, r.sharp_edges, r.sharpness, r.sharp_faces, r.corners
         parent = parent[r.face_parent]

@@ -176,7 +176,7 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
     max_memory : int, float or str, optional
         Refuse (``OutputTooLargeError``) if the refinement is estimated to need more bytes than
         this (e.g. ``8e9``, ``"8G"``, ``"none"``). Default: :func:`hybridsub.set_memory_limit`,
-        else the environment variable ``HYBRIDSUB_MAX_MEMORY``, else half of the physical memory.
+        else the environment variable ``HYBRIDSUB_MAX_MEMORY``, else 80 % of the physical memory.
 
     Returns
     -------

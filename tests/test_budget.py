@@ -129,8 +129,8 @@ def test_message_numbers_are_the_estimate():
 
 def test_limit_sources_and_precedence(monkeypatch):
     F = ms.icosahedron()[1]
-    hybridsub.refine(F, levels=2)  # default: half the RAM, plenty
-    assert hybridsub.get_memory_limit() == pytest.approx(0.5 * _budget.physical_memory())
+    hybridsub.refine(F, levels=2)  # default: 80 % of the RAM, plenty
+    assert hybridsub.get_memory_limit() == pytest.approx(0.8 * _budget.physical_memory())
     monkeypatch.setenv("HYBRIDSUB_MAX_MEMORY", "1k")
     assert hybridsub.get_memory_limit() == 1000
     with pytest.raises(OutputTooLargeError, match="set by HYBRIDSUB_MAX_MEMORY"):
@@ -238,3 +238,17 @@ def test_real_int64_overflow():  # pragma: no cover - needs a big machine
     V, F = hybridsub.load_example()
     r = hybridsub.refine(F, levels=8, scheme="loop", max_memory="none")
     assert r.steps[-1].matrix.indices.dtype == np.int64
+
+
+def test_command_line_reports_the_limit_and_force_lifts_it(monkeypatch, tmp_path, capsys):
+    from hybridsub import _cli
+
+    V, F = ms.octahedron()
+    src = tmp_path / "octa.off"
+    src.write_text("OFF\n6 8 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in V)
+                   + "".join(f"3 {a} {b} {c}\n" for a, b, c in F))
+    monkeypatch.setenv("HYBRIDSUB_MAX_MEMORY", "100")
+    assert _cli.main(["subdivide", str(src), "-o", str(tmp_path / "a.obj"), "--levels", "2", "-q"]) == 1
+    err = capsys.readouterr().err
+    assert "set by HYBRIDSUB_MAX_MEMORY" in err and "--force" in err
+    assert _cli.main(["subdivide", str(src), "-o", str(tmp_path / "a.obj"), "--levels", "2", "-q", "--force"]) == 0
