@@ -15,9 +15,8 @@ import scipy.sparse as sp
 from . import _budget
 from . import _repair
 from . import _validate as val
-from ._errors import MeshError
 from ._stencils import apply_matrix, apply_step, step_matrix
-from ._topology import build_level, child_creases, child_level, face_parents, plan_step
+from ._topology import child_creases, child_level, face_parents, plan_step
 
 
 @dataclass(frozen=True, eq=False)

@@ -31,7 +31,6 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from . import _validate as val
-from ._errors import MeshError
 
 
 @dataclass(frozen=True, eq=False)
