@@ -132,7 +132,7 @@ def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
         n_vertices = _count(n_vertices, "n_vertices")
     A = _array(F, "F", 3, "face", "m")
     if A.ndim == 1 and A.size == 0:
-        A = A.reshape(0, 3).astype(np.int64)
+        A = A.reshape(0, 3)
     if A.dtype == bool:
         raise TypeError("F must hold integer vertex indices, got a boolean array")
     if not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
