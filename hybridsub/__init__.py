@@ -11,7 +11,8 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 True
 """
 
-from ._errors import MeshError
+from ._budget import get_memory_limit, set_memory_limit
+from ._errors import MeshError, OutputTooLargeError
 from ._examples import load_example
 from ._facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from ._features import Features, detect_features
@@ -21,7 +22,8 @@ from ._refine import Refinement, RefinementStep, refine, subdivide
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
-    "load_example", "subdivide_mesh", "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying",
-    "refine_face_varying", "FaceVaryingRefinement", "seam_edges",
+    "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
+    "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
+    "FaceVaryingRefinement", "seam_edges",
 ]
 __version__ = "0.1.0"

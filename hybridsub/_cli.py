@@ -18,7 +18,7 @@ import numpy as np
 
 from . import __version__
 from . import _io
-from ._errors import MeshError
+from ._errors import MeshError, OutputTooLargeError
 from ._examples import example_path
 from ._features import detect_features
 from ._io import TaggedMesh
@@ -263,9 +263,11 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     bar = ProgressBar([p["faces"] for p in pred], scheme, enabled=not a.quiet and sys.stderr.isatty())
     try:
         res = refine_by_level(X, mesh.faces, levels, scheme=scheme, loop_weights=a.loop_weights,
-                              on_level=bar.update, **feat.tags())
+                              on_level=bar.update, max_memory="none" if a.force else None, **feat.tags())
     except MeshError as e:
         raise CLIError(f"{path}: {e}") from None
+    except OutputTooLargeError as e:  # the library's memory limit (HYBRIDSUB_MAX_MEMORY); --force lifts it
+        raise CLIError(f"{path}: {e}, or pass --force") from None
     except MemoryError:
         raise CLIError(f"out of memory refining {path} ({levels} levels of {scheme}); use fewer levels") from None
     finally:

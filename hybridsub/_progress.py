@@ -30,10 +30,11 @@ class LevelResult:
 
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
-                    corners=None, loop_weights="loop", on_level=None) -> LevelResult:
+                    corners=None, loop_weights="loop", on_level=None, max_memory=None) -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
-    ``on_level(done, levels, n_faces, seconds)`` is called after each level.
+    ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
+    as in :func:`hybridsub.subdivide`.
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
@@ -43,7 +44,8 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     total = 0.0
     t = time.perf_counter()
     for out in subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
-                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights):
+                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                                max_memory=max_memory):
         X, F, pairs, sharp, mask = out.X, out.faces, out.sharp_edges, out.sharpness, out.sharp_faces
         parent = parent[out.face_parent]
         dt = time.perf_counter() - t

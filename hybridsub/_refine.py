@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from . import _budget
+from . import _repair
 from . import _validate as val
-from ._errors import MeshError
 from ._stencils import apply_matrix, apply_step, step_matrix
-from ._topology import build_level, child_creases, child_level, face_parents, plan_step
+from ._topology import child_creases, child_level, face_parents, plan_step
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,6 +95,7 @@ class Refinement:
         if "matrix" not in self._cache:
             S = sp.identity(self.n_coarse, format="csr", dtype=np.float64)
             for st in self.steps:
+                _budget.check_product(st.matrix, S, self._cache.get("max_memory"))  # size guard
                 S = st.matrix @ S
             S = sp.csr_matrix(S)
             S.sort_indices()
@@ -104,7 +106,8 @@ class Refinement:
         """Refine per-vertex data: positions, UVs, colours, any (n_coarse, ...) array.
 
         Floating-point data keeps its dtype (computed in float64); other data comes back as
-        float64. The step matrices are applied one after the other, which is cheaper than the
+        float64; complex data stays complex. The result is always a new array, also with no
+        steps. The step matrices are applied one after the other, which is cheaper than the
         composite when the matrix has not been formed.
 
         Examples
@@ -115,21 +118,26 @@ class Refinement:
         >>> r.apply(V).shape
         (7, 3)
         """
-        A = np.asarray(X)
-        if A.ndim == 0 or A.shape[0] != self.n_coarse:
-            raise MeshError(f"data must have one row per coarse vertex ({self.n_coarse}), got shape {A.shape}")
-        out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
-        Y = np.asarray(A, dtype=np.float64).reshape(self.n_coarse, -1)
-        if "matrix" in self._cache:
+        A, out_dtype, work = val.as_data(X, self.n_coarse)  # dtypes, shapes, never a view
+        Y = np.asarray(A, dtype=work).reshape(self.n_coarse, int(np.prod(A.shape[1:], dtype=np.int64)))
+        if work == np.complex128:  # real and imaginary parts side by side
+            Y = np.concatenate([Y.real, Y.imag], axis=1)
+        if not self.steps:
+            Y = Y.copy()
+        elif "matrix" in self._cache:
             Y = apply_matrix(self._cache["matrix"], Y)
         else:
             for st in self.steps:
                 Y = apply_matrix(st.matrix, Y)
+        if work == np.complex128:
+            k = Y.shape[1] // 2
+            Y = Y[:, :k] + 1j * Y[:, k:]
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
 
 
 def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
-           sharp_faces=None, corners=None, loop_weights="loop") -> Refinement:
+           sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise",
+           max_memory=None) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -153,6 +161,21 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
         Vertices that never move.
     loop_weights : {"loop", "warren"}
         Smooth vertex weights in Loop regions.
+    non_manifold : {"raise", "cut"}
+        What to do with edges in three or more faces, and edges whose two faces run along them
+        in the same direction (inconsistent orientation). ``"raise"`` (default): a
+        ``MeshError`` naming the edge. ``"cut"``: cut the mesh along them — each vertex of such
+        an edge gets one copy per sector of faces around it, so the cut edges become boundary
+        edges (creases) of the pieces; its vertices become corners, except one on exactly two
+        cut edges, which stays a crease vertex. In ``"hybrid"`` and ``"loop"`` the copies stay
+        together at every level; in ``"sqrt3"`` each piece has Kobbelt's boundary. The output
+        has vertices ``0 .. n-1`` (the input's), then the extra copies (in order of input
+        vertex), then the new points; ``matrix``, ``steps[0].matrix`` and ``apply`` take the
+        input's ``n`` vertices. Duplicate faces are an error either way. See ``docs/errors.md``.
+    max_memory : int, float or str, optional
+        Refuse (``OutputTooLargeError``) if the refinement is estimated to need more bytes than
+        this (e.g. ``8e9``, ``"8G"``, ``"none"``). Default: :func:`hybridsub.set_memory_limit`,
+        else the environment variable ``HYBRIDSUB_MAX_MEMORY``, else 80 % of the physical memory.
 
     Returns
     -------
@@ -167,6 +190,11 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
     >>> r.faces.shape, r.matrix.shape
     ((36, 3), (20, 4))
     """
+    budget = _budget.Budget(val.check_options(scheme, levels, loop_weights), scheme, max_memory)
+    if val.check_non_manifold(non_manifold) == "cut":  # cut, refine the cut mesh, compose
+        return _repair.refine_cut(refine, F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme,
+                                  sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
+                                  loop_weights=loop_weights, max_memory=max_memory)
     levels, Fi, n, pairs, sharp, face_sharp, faces_as_indices, corner = _prepare(
         F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
 
@@ -180,15 +208,17 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
         steps = [RefinementStep(Fi.copy(), sp.identity(n, format="csr"), pairs, sharp, faces_out(face_sharp),
                                 corners_out, face_parent) for _ in range(levels)]
     for level, plan, faces, child, offsets in _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner,
-                                                    loop_weights, topology_last=True):
+                                                    loop_weights, topology_last=True, budget=budget):
         pairs, sharp = child_creases(level, plan)
         parent = face_parents(offsets)
         face_parent = face_parent[parent]
         steps.append(RefinementStep(faces, step_matrix(level, plan), pairs, sharp, faces_out(child.face_sharp),
                                     corners_out, parent))
     last = steps[-1] if steps else None
-    return Refinement(last.faces if last else Fi.copy(), pairs, sharp,
-                      last.sharp_faces if last else faces_out(face_sharp), corners_out, face_parent, steps, n)
+    r = Refinement(last.faces if last else Fi.copy(), pairs, sharp,
+                   last.sharp_faces if last else faces_out(face_sharp), corners_out, face_parent, steps, n)
+    r._cache["max_memory"] = max_memory  # the composite matrix honours the same limit
+    return r
 
 
 def _prepare(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights):
@@ -205,21 +235,25 @@ def _prepare(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces,
         )
     if scheme == "loop":
         face_sharp[:] = True
+    if levels == 0 or len(Fi) == 0:  # topology and tags get the same answer at every level count
+        val.checked_level(Fi, n, pairs)
     keep = sharp > 0
     return levels, Fi, n, pairs[keep], sharp[keep], face_sharp, faces_as_indices, corner
 
 
-def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last):
+def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last, budget=None):
     """Run the steps; yield (level, plan, child faces, child level, child offsets) for each.
 
     The child level of the last step (its twins and tags) is built only if
-    ``topology_last``.
+    ``topology_last``. ``budget`` (a ``_budget.Budget``) may refuse before a step allocates.
     """
     if levels == 0 or len(Fi) == 0:
         return
-    level = build_level(Fi, n).tag(pairs, sharp, face_sharp)
+    level = val.checked_level(Fi, n, pairs).tag(pairs, sharp, face_sharp)  # named topology errors
     for step in range(1, levels + 1):
         plan = plan_step(level, corner, scheme, step, loop_weights)
+        if budget is not None:
+            budget.check(step, level, plan)  # before this step allocates anything large
         faces, child, offsets = child_level(level, plan, want_topology=topology_last or step < levels)
         yield level, plan, faces, child, offsets
         corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
@@ -227,7 +261,7 @@ def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights,
 
 
 def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-              corners=None, loop_weights="loop", return_matrix=False):
+              corners=None, loop_weights="loop", return_matrix=False, non_manifold="raise", max_memory=None):
     """Subdivide a triangle mesh, keeping its sharp features.
 
     Parameters
@@ -254,11 +288,18 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
         Smooth vertex weights in Loop regions.
     return_matrix : bool
         Also return the composite refinement matrix S (``V2 == S @ V``).
+    non_manifold : {"raise", "cut"}
+        ``"cut"`` cuts the mesh along edges in three or more faces and along inconsistently
+        oriented edges instead of raising; see :func:`refine`.
+    max_memory : int, float or str, optional
+        Memory limit in bytes for this call; see :func:`refine` and ``docs/errors.md``.
 
     Returns
     -------
     V2 : (n', 3) ndarray
-        Refined positions, in the dtype of ``V`` if it is floating-point, else float64.
+        Refined positions, in the dtype of ``V`` if it is floating-point, else float64 (always
+        computed in float64; a new array, also for ``levels=0``). Vertices no face uses are
+        kept and do not move.
     F2 : (m', 3) int64 ndarray
         Refined faces.
     S : scipy.sparse.csr_matrix, (n', n)
@@ -276,19 +317,20 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
     >>> bool(np.allclose(S @ V, V2))
     True
     """
-    A = np.asarray(V)
-    Vf = val.as_vertices(A)
-    out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
-    if return_matrix:
+    Vf, out_dtype = val.as_vertices(V, return_dtype=True)
+    if return_matrix or val.check_non_manifold(non_manifold) == "cut":
         r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
-                   sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
-        return r.apply(Vf).astype(out_dtype, copy=False), r.faces, r.matrix
-    X, faces = Vf.copy(), np.asarray(F)
+                   sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                   non_manifold=non_manifold, max_memory=max_memory)
+        V2 = r.apply(Vf).astype(out_dtype, copy=False)
+        return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
+    X = faces = None
     for out in subdivide_levels(Vf, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
-                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False):
+                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False,
+                                max_memory=max_memory):
         X, faces = out.X, out.faces
-    if faces is F or levels == 0:
-        faces = val.as_faces(F, len(Vf))[0].copy()
+    if X is None:  # no step ran: copies of the input
+        X, faces = Vf.copy(), val.as_faces(F, len(Vf))[0].copy()
     return X.astype(out_dtype, copy=False), faces
 
 
@@ -306,19 +348,20 @@ class LevelOutput:
 
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-                     corners=None, loop_weights="loop", tags=True):
+                     corners=None, loop_weights="loop", tags=True, max_memory=None):
     """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
     (the command line's progress bar) or the propagated tags with the positions. ``X`` is
     any (n, d) per-vertex data, already validated as float64. With ``tags=False`` the last
-    level's tags are not computed (nor its twins).
+    level's tags are not computed (nor its twins). ``max_memory`` as in :func:`subdivide`.
     """
-    n = len(X)
     levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
-        F, sharp_edges, levels, n, scheme, sharpness, sharp_faces, corners, loop_weights)
+        F, sharp_edges, levels, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
+    budget = _budget.Budget(levels, scheme, max_memory, keeps_steps=False)
     for k, (level, plan, faces, child, offsets) in enumerate(
-            _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last=tags), 1):
+            _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last=tags,
+                  budget=budget), 1):
         X = apply_step(level, plan, X)
         if tags:
             pairs, sharp = child_creases(level, plan)

@@ -30,7 +30,10 @@ def step_matrix(level: Level, plan: StepPlan) -> sp.csr_matrix:
     indices = np.empty(nnz, index)
     data = np.empty(nnz, np.float64)
     K.fill_matrix(*args, indptr, indices, data)
-    return sp.csr_matrix((data, indices, indptr.astype(index, copy=False)), shape=shape, copy=False)
+    S = sp.csr_matrix((data, indices, indptr.astype(index, copy=False)), shape=shape, copy=False)
+    if S.indices.dtype != index:  # scipy narrows int64 indices whose values fit; keep the choice above
+        S.indices, S.indptr = indices, indptr.astype(index, copy=False)
+    return S
 
 
 def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:

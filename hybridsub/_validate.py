@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _rules as R
 from ._errors import MeshError
+from ._topology import build_level
 
 SCHEMES = ("hybrid", "sqrt3", "loop")
 
@@ -34,61 +35,137 @@ def check_options(scheme, levels, loop_weights) -> int:
     return levels
 
 
-def as_vertices(V) -> np.ndarray:
-    """(n, 3) float64 C-contiguous copy-or-view of V (never written to)."""
-    A = np.asarray(V)
+NON_MANIFOLD = ("raise", "cut")
+
+
+def check_non_manifold(non_manifold) -> str:
+    if not isinstance(non_manifold, str) or non_manifold not in NON_MANIFOLD:
+        raise ValueError(f"non_manifold must be one of {NON_MANIFOLD}, got {non_manifold!r}")
+    return non_manifold
+
+
+def _count(x, name: str) -> int:
+    """A non-negative int option (n_vertices)."""
+    if isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{name} must be a non-negative integer, got {x!r}")
+    try:
+        x = operator.index(x)
+    except TypeError:
+        raise TypeError(f"{name} must be a non-negative integer, got {x!r}") from None
+    if x < 0:
+        raise ValueError(f"{name} must be a non-negative integer, got {x}")
+    return x
+
+
+def _array(x, name: str, width: int, row: str, rows: str = "k") -> np.ndarray:
+    """np.asarray, with numpy's errors on ragged or odd input turned into ones that say what is wrong."""
+    try:
+        return np.asarray(x)
+    except (ValueError, TypeError) as exc:
+        try:
+            lengths = [len(r) for r in x]
+        except TypeError:
+            raise TypeError(f"{name} could not be read as an array ({exc})") from None
+        if width <= 1:
+            raise MeshError(f"{name} must be a regular array, got a ragged nested sequence") from None
+        bad = next((i for i, k in enumerate(lengths) if k != width), 0)
+        hint = _TRIANGULATE if name == "F" and lengths[bad] > 3 else ""
+        raise MeshError(
+            f"{name} must have shape ({rows}, {width}), but its rows have different lengths: {row} {bad} has "
+            f"{lengths[bad]} entries{hint}"
+        ) from None
+
+
+_TRIANGULATE = (
+    ": hybridsub subdivides triangle meshes; triangulate polygons first (e.g. a quad (a, b, c, d) "
+    "becomes (a, b, c) and (a, c, d), or trimesh.Trimesh(vertices, faces) triangulates on load)"
+)
+
+
+def as_vertices(V, return_dtype: bool = False):
+    """(n, 3) float64 C-contiguous copy-or-view of V (never written to).
+
+    With ``return_dtype``, also the dtype results should take: V's if floating, else float64.
+    """
+    A = _array(V, "V", 3, "vertex", "n")
+    if A.ndim == 1 and A.size == 0:
+        A = A.reshape(0, 3)
     if A.dtype == object or not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
-        raise TypeError(f"V must be a numeric array of shape (n, 3), got dtype {A.dtype}")
+        raise TypeError(f"V must be a real numeric array of shape (n, 3), got dtype {A.dtype}")
     if A.ndim != 2 or A.shape[1] != 3:
         hint = " (2-D points: append a zero z column, e.g. np.c_[V, np.zeros(len(V))])" if (
             A.ndim == 2 and A.shape[1] == 2) else ""
         raise MeshError(f"V must have shape (n, 3), got {A.shape}{hint}")
+    dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.dtype(np.float64)
     A = np.ascontiguousarray(A, dtype=np.float64)
     bad = ~np.isfinite(A).all(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise MeshError(f"vertex {i} has a non-finite coordinate {A[i].tolist()} ({int(bad.sum())} such vertices)")
-    return A
+    return (A, dtype) if return_dtype else A
+
+
+def as_data(X, n: int):
+    """Per-vertex data for ``Refinement.apply``: (array, dtype of the result, dtype to compute in)."""
+    A = _array(X, "data", 0, "row")
+    if A.ndim == 0 or A.shape[0] != n:
+        raise MeshError(f"data must have one row per coarse vertex ({n}), got shape {A.shape}")
+    if np.issubdtype(A.dtype, np.complexfloating):
+        return A, A.dtype, np.complex128
+    if np.issubdtype(A.dtype, np.floating):
+        return A, A.dtype, np.float64
+    if A.dtype == bool or np.issubdtype(A.dtype, np.integer):
+        return A, np.dtype(np.float64), np.float64
+    raise TypeError(f"data must be numeric, got dtype {A.dtype}")
+
+
+def _integral(A: np.ndarray) -> np.ndarray:
+    """Rows of a float array that do not hold integers (NaN and inf included)."""
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(A) | (A != np.round(A))
+    return bad.any(axis=1) if bad.ndim == 2 else bad
 
 
 def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
     """(m, 3) int64 C-contiguous faces, checked; returns (faces, n_vertices)."""
-    A = np.asarray(F)
-    if A.ndim != 2 or A.shape[1] != 3:
-        if A.ndim == 2 and A.shape[1] > 3:
-            raise MeshError(
-                f"F must have shape (m, 3), got {A.shape}: hybridsub subdivides triangle meshes; "
-                "triangulate polygons first (e.g. a quad (a, b, c, d) becomes (a, b, c) and (a, c, d), "
-                "or trimesh.Trimesh(vertices, faces) triangulates on load)"
-            )
-        raise MeshError(f"F must have shape (m, 3), got {A.shape}")
-    if np.issubdtype(A.dtype, np.integer) or A.dtype == bool:
-        if A.dtype == bool:
-            raise TypeError("F must hold integer vertex indices, got a boolean array")
-        if A.size and np.issubdtype(A.dtype, np.unsignedinteger) and A.max() > np.iinfo(np.int64).max:
-            raise MeshError(f"F holds an index too large for int64: {A.max()}")
-        Fi = np.ascontiguousarray(A, dtype=np.int64)
-    elif np.issubdtype(A.dtype, np.floating):
-        if not np.isfinite(A).all() or (A != np.round(A)).any():
-            f = int(np.flatnonzero(~np.isfinite(A).all(axis=1) | (A != np.round(A)).any(axis=1))[0])
-            raise MeshError(f"F must hold integer vertex indices; face {f} is {A[f].tolist()}")
-        Fi = np.ascontiguousarray(A, dtype=np.int64)
-    else:
+    if n_vertices is not None:
+        n_vertices = _count(n_vertices, "n_vertices")
+    A = _array(F, "F", 3, "face", "m")
+    if A.ndim == 1 and A.size == 0:
+        A = A.reshape(0, 3)
+    if A.dtype == bool:
+        raise TypeError("F must hold integer vertex indices, got a boolean array")
+    if not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
         raise TypeError(f"F must be an integer array of shape (m, 3), got dtype {A.dtype}")
-    if Fi.size:
-        neg = (Fi < 0).any(axis=1)
+    if A.ndim != 2 or A.shape[1] != 3:
+        hint = _TRIANGULATE if A.ndim == 2 and A.shape[1] > 3 else ""
+        raise MeshError(f"F must have shape (m, 3), got {A.shape}{hint}")
+    if np.issubdtype(A.dtype, np.floating) and A.size:
+        frac = _integral(A)
+        if frac.any():
+            f = int(np.flatnonzero(frac)[0])
+            raise MeshError(f"F must hold integer vertex indices; face {f} is {A[f].tolist()}")
+    if A.size:
+        neg = (A < 0).any(axis=1)
         if neg.any():
             f = int(np.flatnonzero(neg)[0])
-            raise MeshError(f"face {f} has a negative vertex index: {Fi[f].tolist()}")
-        top = int(Fi.max())
-        if n_vertices is None:
-            n_vertices = top + 1
-        elif top >= n_vertices:
-            f = int(np.flatnonzero((Fi >= n_vertices).any(axis=1))[0])
+            raise MeshError(f"face {f} = {A[f].tolist()} has a negative vertex index")
+        top = A.max()
+        limit = n_vertices if n_vertices is not None else 2**62
+        if top >= limit:
+            f = int(np.flatnonzero((A >= limit).any(axis=1))[0])
+            if n_vertices is None:
+                raise MeshError(f"face {f} = {A[f].tolist()} refers to vertex {A[f].max()}, too large an index")
             raise MeshError(
-                f"face {f} = {Fi[f].tolist()} refers to vertex {int(Fi[f].max())}, but there are only "
+                f"face {f} = {A[f].tolist()} refers to vertex {A[f].max()}, but there are only "
                 f"{n_vertices} vertices (valid indices 0..{n_vertices - 1})"
             )
+        if n_vertices is None:
+            n_vertices = int(top) + 1
+    elif n_vertices is None:
+        n_vertices = 0
+    Fi = np.ascontiguousarray(A, dtype=np.int64)
+    if Fi.size:
         rep = (Fi[:, 0] == Fi[:, 1]) | (Fi[:, 1] == Fi[:, 2]) | (Fi[:, 2] == Fi[:, 0])
         if rep.any():
             f = int(np.flatnonzero(rep)[0])
@@ -96,11 +173,6 @@ def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
                 f"face {f} = {Fi[f].tolist()} repeats a vertex (a degenerate face with {int(rep.sum())} "
                 "like it); remove such faces first, e.g. trimesh's mesh.update_faces(mesh.nondegenerate_faces())"
             )
-    elif n_vertices is None:
-        n_vertices = 0
-    n_vertices = operator.index(n_vertices)
-    if n_vertices < 0:
-        raise ValueError(f"n_vertices must be non-negative, got {n_vertices}")
     return Fi, n_vertices
 
 
@@ -110,27 +182,41 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
         if sharpness is not None and np.size(sharpness):
             raise ValueError("sharpness was given without sharp_edges")
         return np.empty((0, 2), np.int64), np.empty(0)
-    E = np.asarray(sharp_edges)
+    E = _array(sharp_edges, "sharp_edges", 2, "row")
     if E.size == 0:
         E = E.reshape(0, 2)
+    if E.dtype == bool or not (np.issubdtype(E.dtype, np.integer) or np.issubdtype(E.dtype, np.floating)):
+        raise TypeError(f"sharp_edges must hold integer vertex indices, got dtype {E.dtype}")
     if E.ndim != 2 or E.shape[1] != 2:
         raise MeshError(f"sharp_edges must have shape (k, 2) (vertex pairs), got {E.shape}")
-    if not (np.issubdtype(E.dtype, np.integer) or (np.issubdtype(E.dtype, np.floating)
-                                                  and np.all(E == np.round(E)))):
-        raise TypeError(f"sharp_edges must hold integer vertex indices, got dtype {E.dtype}")
-    E = np.ascontiguousarray(E, dtype=np.int64)
+    if np.issubdtype(E.dtype, np.floating) and E.size:
+        frac = _integral(E)
+        if frac.any():
+            j = int(np.flatnonzero(frac)[0])
+            raise MeshError(f"sharp_edges must hold integer vertex indices; sharp edge {j} is {E[j].tolist()}")
     bad = ((E < 0) | (E >= n_vertices)).any(axis=1)
     if bad.any():
         j = int(np.flatnonzero(bad)[0])
-        raise MeshError(f"sharp edge {j} = {E[j].tolist()} refers to a vertex outside 0..{n_vertices - 1}")
+        raise MeshError(
+            f"sharp edge {j} = {E[j].tolist()} refers to a vertex outside 0..{n_vertices - 1} "
+            f"(there are {n_vertices} vertices)"
+        )
+    E = np.ascontiguousarray(E, dtype=np.int64)
     if sharpness is None:
         s = np.full(len(E), np.inf)
     else:
-        s = np.asarray(sharpness, dtype=np.float64).reshape(-1)
+        S = _array(sharpness, "sharpness", 1, "entry")
+        if S.dtype == bool or not (np.issubdtype(S.dtype, np.integer) or np.issubdtype(S.dtype, np.floating)):
+            raise TypeError(f"sharpness must be real numbers (inf: infinitely sharp), got dtype {S.dtype}")
+        s = np.array(S, dtype=np.float64).reshape(-1)
         if s.shape != (len(E),):
             raise MeshError(f"sharpness must have one value per sharp edge ({len(E)}), got {s.shape[0]}")
         if np.isnan(s).any():
-            raise MeshError(f"sharpness {int(np.flatnonzero(np.isnan(s))[0])} is NaN")
+            j = int(np.flatnonzero(np.isnan(s))[0])
+            raise MeshError(
+                f"sharpness {j} (of sharp edge {E[j].tolist()}) is NaN; give a number: > 0 for a crease "
+                "(>= 10 or inf: infinitely sharp), <= 0 for none"
+            )
         s = R.normalize_sharpness(s)
     return E, s
 
@@ -139,10 +225,12 @@ def as_face_mask(sharp_faces, n_faces: int) -> tuple[np.ndarray, bool]:
     """Boolean (m,) mask, and whether the caller gave indices (True) or a mask (False)."""
     if sharp_faces is None:
         return np.zeros(n_faces, dtype=bool), False
-    A = np.asarray(sharp_faces)
+    A = _array(sharp_faces, "sharp_faces", 1, "entry")
     if A.dtype == bool:
         if A.shape != (n_faces,):
-            raise MeshError(f"sharp_faces as a boolean mask must have shape ({n_faces},), got {A.shape}")
+            raise MeshError(
+                f"sharp_faces as a boolean mask must have one entry per face, shape ({n_faces},), got {A.shape}"
+            )
         return A.copy(), False
     idx = _indices(A, n_faces, "sharp_faces", "face")
     mask = np.zeros(n_faces, dtype=bool)
@@ -154,10 +242,12 @@ def as_corner_mask(corners, n_vertices: int) -> np.ndarray:
     mask = np.zeros(n_vertices, dtype=bool)
     if corners is None:
         return mask
-    A = np.asarray(corners)
+    A = _array(corners, "corners", 1, "entry")
     if A.dtype == bool:
         if A.shape != (n_vertices,):
-            raise MeshError(f"corners as a boolean mask must have shape ({n_vertices},), got {A.shape}")
+            raise MeshError(
+                f"corners as a boolean mask must have one entry per vertex, shape ({n_vertices},), got {A.shape}"
+            )
         return A.copy()
     mask[_indices(A, n_vertices, "corners", "vertex")] = True
     return mask
@@ -166,15 +256,126 @@ def as_corner_mask(corners, n_vertices: int) -> np.ndarray:
 def _indices(A, n: int, name: str, what: str) -> np.ndarray:
     A = A.reshape(-1) if A.ndim <= 1 else A
     if A.ndim != 1:
-        raise MeshError(f"{name} must be a 1-D array of {what} indices, got shape {A.shape}")
+        raise MeshError(f"{name} must be a 1-D array of {what} indices (or a boolean mask), got shape {A.shape}")
     if A.size == 0:
         return np.empty(0, np.int64)
-    if not (np.issubdtype(A.dtype, np.integer) or (np.issubdtype(A.dtype, np.floating)
-                                                  and np.all(A == np.round(A)))):
+    if not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
         raise TypeError(f"{name} must hold integer {what} indices (or be a boolean mask), got dtype {A.dtype}")
-    idx = A.astype(np.int64)
-    bad = (idx < 0) | (idx >= n)
+    if np.issubdtype(A.dtype, np.floating):
+        frac = _integral(A)
+        if frac.any():
+            j = int(np.flatnonzero(frac)[0])
+            raise MeshError(f"{name} must hold integer {what} indices; {name}[{j}] is {A[j]}")
+    bad = (A < 0) | (A >= n)
     if bad.any():
         j = int(np.flatnonzero(bad)[0])
-        raise MeshError(f"{name}[{j}] = {idx[j]} is not a {what} index (valid 0..{n - 1})")
-    return idx
+        valid = f"valid 0..{n - 1}" if n else f"there is no {what}"
+        raise MeshError(f"{name}[{j}] = {A[j]} is not a {what} index ({valid})")
+    return A.astype(np.int64)
+
+
+# --------------------------------------------------------------------------------------
+# Topology: what build_level cannot take, named
+
+
+def checked_level(F: np.ndarray, n: int, pairs: np.ndarray | None = None):
+    """``build_level(F, n)``, with every topology problem reported by name.
+
+    Reports duplicate faces, non-manifold edges and inconsistent orientation (with how to fix
+    each), and sharp edges (``pairs``) that are not edges of the mesh.
+    """
+    try:
+        level = build_level(F, n)
+    except MeshError as exc:
+        raise (topology_error(F) or exc) from None
+    if level.n_faces:
+        t = level.twin.reshape(-1, 3)
+        tf = t // 3
+        # A face whose three edges all lie in the same other face: a duplicate with opposite
+        # orientation, the two making a closed two-triangle "pillow" build_level accepts.
+        pillow = (t >= 0).all(axis=1) & (tf[:, 0] == tf[:, 1]) & (tf[:, 1] == tf[:, 2])
+        if pillow.any():
+            raise duplicate_faces_error(F)
+    if pairs is not None and len(pairs):
+        eid = level.find_edges(pairs)
+        missing = (eid < 0) | (pairs[:, 0] == pairs[:, 1])
+        if missing.any():
+            raise not_an_edge_error(pairs, np.flatnonzero(missing))
+    return level
+
+
+def not_an_edge_error(pairs: np.ndarray, missing: np.ndarray) -> MeshError:
+    j = int(missing[0])
+    u, w = int(pairs[j, 0]), int(pairs[j, 1])
+    why = f"it joins vertex {u} to itself" if u == w else f"no face has both vertex {u} and vertex {w}"
+    more = f" ({len(missing)} such rows)" if len(missing) > 1 else ""
+    return MeshError(f"sharp edge {j} = [{u}, {w}] is not an edge of the mesh: {why}{more}")
+
+
+def duplicate_faces_error(F: np.ndarray) -> MeshError | None:
+    """A MeshError naming the first face that repeats an earlier one's vertices, or None."""
+    if len(F) < 2:
+        return None
+    S = np.sort(F, axis=1)
+    order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))  # stable: ties in face order
+    Ss = S[order]
+    same = (Ss[1:] == Ss[:-1]).all(axis=1)
+    if not same.any():
+        return None
+    new = np.concatenate([[True], ~same])
+    first = order[new][np.cumsum(new) - 1]  # the lowest face of each group
+    dup = order[1:][same]
+    orig = first[1:][same]
+    k = int(np.argmin(dup))
+    f, g = int(orig[k]), int(dup[k])
+    rotations = [np.roll(F[g], r) for r in range(3)]
+    how = "the same" if any((x == F[f]).all() for x in rotations) else "opposite"
+    return MeshError(
+        f"faces {f} and {g} are duplicate faces: both are the triangle on vertices {sorted(F[f].tolist())}, "
+        f"with {how} orientation ({int(same.sum())} duplicate face{'s' if same.sum() > 1 else ''} in all); "
+        "remove the duplicates "
+        "first, e.g. with trimesh: mesh.update_faces(mesh.unique_faces())"
+    )
+
+
+def topology_error(F: np.ndarray) -> MeshError | None:
+    """The first topology problem of F, described with a fix: duplicate faces, then edges in
+    three or more faces, then edges whose two faces disagree on orientation. None if none."""
+    dup = duplicate_faces_error(F)
+    if dup is not None:
+        return dup
+    m = len(F)
+    u = F.ravel()
+    w = F[:, [1, 2, 0]].ravel()
+    lo, hi = np.minimum(u, w), np.maximum(u, w)
+    order = np.lexsort((hi, lo))  # halfedges by edge, ties in halfedge order
+    ls, hs = lo[order], hi[order]
+    new = np.ones(3 * m, dtype=bool)
+    new[1:] = (ls[1:] != ls[:-1]) | (hs[1:] != hs[:-1])
+    starts = np.flatnonzero(new)
+    sizes = np.diff(np.append(starts, 3 * m))
+    a = order[starts]
+    b = order[np.minimum(starts + 1, 3 * m - 1)]
+    many = sizes >= 3
+    if many.any():
+        g = int(np.flatnonzero(many)[np.argmin(a[many])])
+        faces = sorted((order[starts[g]:starts[g] + sizes[g]] // 3).tolist())
+        more = f"; {int(many.sum())} such edges in all" if many.sum() > 1 else ""
+        return MeshError(
+            f"edge ({int(ls[starts[g]])}, {int(hs[starts[g]])}) is shared by {len(faces)} faces {faces}: the "
+            f"mesh is not edge-manifold (every edge must lie in one or two faces){more}. Remove the extra "
+            "faces, or pass non_manifold=\"cut\" to cut the mesh along such edges (they become creases "
+            "where the pieces meet; see docs/errors.md)"
+        )
+    flipped = (sizes == 2) & (u[a] == u[b])
+    if flipped.any():
+        g = int(np.flatnonzero(flipped)[np.argmin(a[flipped])])
+        h1, h2 = int(a[g]), int(b[g])
+        more = f"; {int(flipped.sum())} such edges in all" if flipped.sum() > 1 else ""
+        return MeshError(
+            f"faces {h1 // 3} and {h2 // 3} both run along edge {int(u[h1])}->{int(w[h1])} in the same "
+            f"direction: the mesh is not consistently oriented{more}. Reverse the vertex order of the faces "
+            "on one side (e.g. trimesh.repair.fix_winding(mesh), or igl.bfs_orient(F)); a surface that "
+            "cannot be oriented (a Möbius strip) can be cut along such edges with non_manifold=\"cut\""
+        )
+    return None

@@ -13,6 +13,8 @@ by Hypothesis itself, so they shrink.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
@@ -597,3 +599,230 @@ def tagged_meshes(draw, kind="any", *, sharpness="maybe", sharp_faces=True, corn
     if corners and draw(st.booleans()):
         tags["corners"] = draw(corner_tags(len(V)))
     return V, F, tags
+
+
+# ------------------------------- broken meshes ------------------------------------------
+#
+# Each strategy below returns a ``Broken`` case: arguments for ``hybridsub.subdivide`` that
+# must be refused, the exception type the docs (docs/errors.md) promise, and a fragment the
+# message must contain.
+
+
+@dataclass
+class Broken:
+    """A call ``hybridsub.subdivide(V, F, **kwargs)`` that must raise ``error`` (message
+    containing ``match``)."""
+
+    what: str
+    V: object
+    F: object
+    kwargs: dict = field(default_factory=dict)
+    error: type = ValueError
+    match: str = ""
+
+
+def _mesh_error():
+    import hybridsub  # noqa: F401  (imported late: the valid-mesh strategies need no hybridsub)
+
+    return hybridsub.MeshError
+
+
+def add_fin(F, n, edge):
+    """Faces plus one triangle on ``edge`` = (u, w) and a new vertex ``n``: a third face on an
+    interior edge makes it non-manifold."""
+    u, w = int(edge[0]), int(edge[1])
+    return np.vstack([F, [[u, w, n]]]).astype(np.int64)
+
+
+def flip_face(F, f):
+    F = np.array(F, dtype=np.int64, copy=True)
+    F[f] = F[f][::-1]
+    return F
+
+
+@st.composite
+def broken_shapes(draw):
+    """V or F of the wrong shape, dtype or content (no topology involved)."""
+    V, F = draw(meshes("any", max_points=30))
+    rng = draw(rngs())
+    ME = _mesh_error()
+    n, m = len(V), len(F)
+    kind = draw(st.sampled_from([
+        "V2", "V4", "V1d", "V3d", "Vstr", "Vcomplex", "Vbool", "Vnan", "Vinf", "Fquad", "F2", "F1d",
+        "Fbool", "Fstr", "Ffrac", "Fnan", "Fneg", "Frange", "Fhuge", "Frepeat", "ragged",
+    ]))
+    v, f = int(rng.integers(n)), int(rng.integers(m))
+    if kind == "V2":
+        return Broken(kind, V[:, :2], F, error=ME, match="(n, 3)")
+    if kind == "V4":
+        return Broken(kind, np.c_[V, V[:, :1]], F, error=ME, match="(n, 3)")
+    if kind == "V1d":
+        return Broken(kind, V.ravel(), F, error=ME, match="(n, 3)")
+    if kind == "V3d":
+        return Broken(kind, V[:, :, None], F, error=ME, match="(n, 3)")
+    if kind == "Vstr":
+        return Broken(kind, V.astype(str), F, error=TypeError, match="V must be")
+    if kind == "Vcomplex":
+        return Broken(kind, V.astype(complex), F, error=TypeError, match="V must be")
+    if kind == "Vbool":
+        return Broken(kind, V > 0, F, error=TypeError, match="V must be")
+    if kind in ("Vnan", "Vinf"):
+        W = V.copy()
+        W[v, int(rng.integers(3))] = np.nan if kind == "Vnan" else -np.inf
+        return Broken(kind, W, F, error=ME, match=f"vertex {v} ")
+    if kind == "Fquad":
+        return Broken(kind, V, np.c_[F, F[:, :1]], error=ME, match="triangulate")
+    if kind == "F2":
+        return Broken(kind, V, F[:, :2], error=ME, match="(m, 3)")
+    if kind == "F1d":
+        return Broken(kind, V, F.ravel(), error=ME, match="(m, 3)")
+    if kind == "Fbool":
+        return Broken(kind, V, F > 0, error=TypeError, match="F must")
+    if kind == "Fstr":
+        return Broken(kind, V, F.astype(str), error=TypeError, match="F must")
+    if kind == "Ffrac":
+        G = F.astype(float)
+        G[f, int(rng.integers(3))] += 0.5
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    if kind == "Fnan":
+        G = F.astype(float)
+        G[f, int(rng.integers(3))] = np.nan
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    if kind == "Fneg":
+        G = F.copy()
+        G[f, int(rng.integers(3))] = -int(rng.integers(1, 5))
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    if kind == "Frange":
+        G = F.copy()
+        G[f, int(rng.integers(3))] = n + int(rng.integers(0, 5))
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    if kind == "Fhuge":
+        G = F.astype(np.uint64)
+        G[f, 0] = np.uint64(2**64 - 1)
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    if kind == "Frepeat":
+        G = F.copy()
+        G[f, 1] = G[f, 0]
+        return Broken(kind, V, G, error=ME, match=f"face {f} ")
+    # ragged: one face with 4 vertices, as a list (all faces of a one-face mesh: a quad array)
+    G = F.tolist()
+    G[f] = G[f] + [G[f][0]]
+    return Broken(kind, V, G, error=ME, match=f"face {f} has 4" if m > 1 else "triangulate")
+
+
+def _interior_edge(F, rng):
+    E = interior_edges(F)
+    if len(E) == 0:
+        return None
+    return E[int(rng.integers(len(E)))]
+
+
+@st.composite
+def broken_topology(draw):
+    """Duplicate faces, non-manifold edges and inconsistent orientation on valid meshes."""
+    V, F = draw(meshes("any", max_points=30))
+    rng = draw(rngs())
+    ME = _mesh_error()
+    n, m = len(V), len(F)
+    kind = draw(st.sampled_from(["duplicate", "duplicate_flipped", "fin", "flip"]))
+    f = int(rng.integers(m))
+    if kind in ("duplicate", "duplicate_flipped"):
+        face = np.roll(F[f], int(rng.integers(3)))
+        if kind == "duplicate_flipped":
+            face = face[::-1]
+        G = np.insert(F, int(rng.integers(m + 1)), face, axis=0)
+        return Broken(kind, V, G, error=ME, match="duplicate face")
+    e = _interior_edge(F, rng)
+    if kind == "fin" and e is not None:
+        W = np.vstack([V, V[e].mean(axis=0) + [0.0, 0.0, 1.0]])
+        return Broken(kind, W, add_fin(F, n, e[:: int(rng.choice([-1, 1]))]), error=ME, match="shared by 3 faces")
+    # flip a face that has an interior edge (a face alone on all sides would stay valid)
+    I = {tuple(x) for x in interior_edges(F).tolist()}
+    cand = [g for g in range(m) if any(tuple(sorted((int(F[g, i]), int(F[g, (i + 1) % 3])))) in I
+                                       for i in range(3))]
+    if not cand:  # no interior edge at all: duplicate instead
+        return Broken("duplicate", V, np.vstack([F, F[f]]), error=ME, match="duplicate face")
+    g = cand[int(rng.integers(len(cand)))]
+    return Broken("flip", V, flip_face(F, g), error=ME, match="same direction")
+
+
+@st.composite
+def broken_tags(draw):
+    """Tags that do not fit the mesh, and bad options."""
+    V, F = draw(meshes("any", max_points=30))
+    rng = draw(rngs())
+    ME = _mesh_error()
+    n, m = len(V), len(F)
+    kind = draw(st.sampled_from([
+        "not_an_edge", "self_loop", "edge_range", "edge_shape", "edge_frac", "sharpness_len",
+        "sharpness_nan", "sharpness_str", "face_range", "face_mask_len", "face_frac", "corner_range",
+        "corner_mask_len", "sqrt3_tags", "levels_neg", "levels_float", "scheme", "loop_weights",
+        "non_manifold", "max_memory",
+    ]))
+    E = edges_of(F)
+    if kind == "not_an_edge":
+        have = {tuple(x) for x in E.tolist()}
+        pairs = [(a, b) for a in range(min(n, 12)) for b in range(a + 1, min(n, 12)) if (a, b) not in have]
+        if pairs:
+            a, b = pairs[int(rng.integers(len(pairs)))]
+            tags = np.vstack([E[:1], [[b, a]]])
+            return Broken(kind, V, F, {"sharp_edges": tags}, ME, "sharp edge 1 ")
+        kind = "self_loop"
+    if kind == "self_loop":
+        return Broken(kind, V, F, {"sharp_edges": [[0, 0]]}, ME, "itself")
+    if kind == "edge_range":
+        return Broken(kind, V, F, {"sharp_edges": [[0, n + int(rng.integers(3))]]}, ME, "sharp edge 0 ")
+    if kind == "edge_shape":
+        return Broken(kind, V, F, {"sharp_edges": E[:1].ravel()[:1]}, ME, "(k, 2)")
+    if kind == "edge_frac":
+        return Broken(kind, V, F, {"sharp_edges": E[:1] + 0.5}, ME, "sharp edge 0 ")
+    if kind == "sharpness_len":
+        return Broken(kind, V, F, {"sharp_edges": E[:1], "sharpness": [1.0, 2.0]}, ME, "one value per")
+    if kind == "sharpness_nan":
+        return Broken(kind, V, F, {"sharp_edges": E[:1], "sharpness": [np.nan]}, ME, "NaN")
+    if kind == "sharpness_str":
+        return Broken(kind, V, F, {"sharp_edges": E[:1], "sharpness": ["x"]}, TypeError, "sharpness")
+    if kind == "face_range":
+        return Broken(kind, V, F, {"sharp_faces": [0, m + int(rng.integers(3))]}, ME, "sharp_faces[1]")
+    if kind == "face_mask_len":
+        return Broken(kind, V, F, {"sharp_faces": np.ones(m + 1, bool)}, ME, "one entry per face")
+    if kind == "face_frac":
+        return Broken(kind, V, F, {"sharp_faces": [0.5]}, ME, "sharp_faces[0]")
+    if kind == "corner_range":
+        return Broken(kind, V, F, {"corners": [-1 - int(rng.integers(3))]}, ME, "corners[0]")
+    if kind == "corner_mask_len":
+        return Broken(kind, V, F, {"corners": np.ones(n - 1, bool)}, ME, "one entry per vertex")
+    if kind == "sqrt3_tags":
+        tag = draw(st.sampled_from([{"sharp_edges": E[:1]}, {"sharp_faces": [0]}, {"corners": [0]}]))
+        return Broken(kind, V, F, dict(tag, scheme="sqrt3"), ValueError, "sqrt3")
+    if kind == "levels_neg":
+        return Broken(kind, V, F, {"levels": -int(rng.integers(1, 4))}, ValueError, "levels")
+    if kind == "levels_float":
+        return Broken(kind, V, F, {"levels": 1.5}, TypeError, "levels")
+    if kind == "scheme":
+        return Broken(kind, V, F, {"scheme": "catmull-clark"}, ValueError, "scheme")
+    if kind == "loop_weights":
+        return Broken(kind, V, F, {"loop_weights": "stam"}, ValueError, "loop_weights")
+    if kind == "non_manifold":
+        return Broken(kind, V, F, {"non_manifold": "ignore"}, ValueError, "non_manifold")
+    return Broken(kind, V, F, {"max_memory": -1}, ValueError, "max_memory")
+
+
+def broken_inputs():
+    return st.one_of(broken_shapes(), broken_topology(), broken_tags())
+
+
+@st.composite
+def non_manifold_meshes(draw, max_fins=3):
+    """Valid meshes made non-manifold (fins on interior edges) or inconsistently oriented
+    (flipped faces): inputs that ``non_manifold="cut"`` must handle."""
+    V, F = draw(meshes("any", max_points=30))
+    rng = draw(rngs())
+    for _ in range(draw(st.integers(1, max_fins))):
+        e = _interior_edge(F, rng)
+        if e is not None and draw(st.booleans()):
+            V = np.vstack([V, V[e].mean(axis=0) + rng.normal(size=3)])
+            F = add_fin(F, len(V) - 1, e[:: int(rng.choice([-1, 1]))])
+        else:
+            F = flip_face(F, int(rng.integers(len(F))))
+    return _mesh(V, F)
