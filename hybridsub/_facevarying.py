@@ -35,7 +35,7 @@ from . import _validate as val
 from ._errors import MeshError
 from ._refine import Refinement, RefinementStep
 from ._stencils import step_matrix
-from ._topology import Level, build_level, child_creases, child_level, face_parents, plan_step
+from ._topology import Level, child_creases, child_level, face_parents, plan_step
 
 UV_MODES = ("linear", "smooth")
 
@@ -88,7 +88,7 @@ def seam_edges(F, FUV) -> np.ndarray:
     T = _as_uv_faces(FUV, len(Fi), None)
     if not len(Fi):
         return np.empty((0, 2), np.int64)
-    level = build_level(Fi, n)
+    level = val.checked_level(Fi, n)
     seam = _seam_halfedges(level, T)
     return level.edge_vertices[seam[level.edge_owner]]
 
@@ -162,7 +162,7 @@ def refine_face_varying(F, FUV, sharp_edges=None, levels=1, *, n_vertices=None, 
 
     geo_steps, uv_steps = [], []
     face_parent = np.arange(m, dtype=np.int64)
-    level = build_level(Fi, n).tag(pairs, sharp, face_sharp)
+    level = val.checked_level(Fi, n, pairs).tag(pairs, sharp, face_sharp)
     uvl = _uv_level(level, T, t)
     uv_corner = _carried_corners(level, uvl, corner)
     uv_corners_out = np.flatnonzero(uv_corner | _irregular_uv(level, uvl))

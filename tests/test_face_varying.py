@@ -351,3 +351,13 @@ def test_errors():
         hybridsub.subdivide_face_varying(V, F, UV, FUV + 0.5)
     with pytest.raises(hybridsub.MeshError, match="not an edge"):
         hybridsub.subdivide_face_varying(V, F, UV, FUV, [[1, 3]])
+
+
+def test_topology_errors_are_named_as_in_subdivide():
+    """Face-varying input goes through the same checks as subdivide: a duplicate face is named."""
+    F = np.array([[0, 1, 2], [0, 2, 1]])
+    V = np.random.default_rng(0).random((3, 3))
+    with pytest.raises(hybridsub.MeshError, match="duplicate"):
+        hybridsub.subdivide(V, F)
+    with pytest.raises(hybridsub.MeshError, match="duplicate"):
+        hybridsub.subdivide_face_varying(V, F, np.zeros((3, 2)), F)
