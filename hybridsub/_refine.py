@@ -219,7 +219,7 @@ def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", s
 
 
 def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-              corners=None, loop_weights="loop", return_matrix=False):
+              corners=None, loop_weights="loop", return_matrix=False, feature_angle=None):
     """Subdivide a triangle mesh, keeping its sharp features.
 
     Parameters
@@ -246,6 +246,9 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
         Smooth vertex weights in Loop regions.
     return_matrix : bool
         Also return the composite refinement matrix S (``V2 == S @ V``).
+    feature_angle : float, optional
+        Also tag what :func:`hybridsub.detect_features` finds at this dihedral angle (degrees):
+        its sharp edges (infinitely sharp, unless given in ``sharp_edges``) and corners.
 
     Returns
     -------
@@ -267,9 +270,14 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
     >>> V2, F2, S = hybridsub.subdivide(V, F, sharp_edges=[[0, 1]], return_matrix=True)
     >>> bool(np.allclose(S @ V, V2))
     True
+    >>> V, F = hybridsub.load_example()
+    >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, feature_angle=30)   # creases found and kept
     """
     A = np.asarray(V)
     Vf = val.as_vertices(A)
+    if feature_angle is not None:  # automatic features (docs/features.md)
+        from ._features import merge_detected
+        sharp_edges, sharpness, corners = merge_detected(Vf, F, feature_angle, sharp_edges, sharpness, corners)
     r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
