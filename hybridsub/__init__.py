@@ -14,10 +14,13 @@ True
 from ._errors import MeshError
 from ._examples import load_example
 from ._features import Features, detect_features
+from ._limit import limit_matrix, limit_normals, limit_positions
 from ._refine import Refinement, RefinementStep, refine, subdivide
+from . import analysis
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
     "load_example",
+    "limit_matrix", "limit_positions", "limit_normals", "analysis",
 ]
 __version__ = "0.1.0"
