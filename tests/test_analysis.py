@@ -143,3 +143,20 @@ def test_bad_arguments():
         analysis.check_smoothness(4.5)
     with pytest.raises(ValueError, match="crease sector needs at least 1 face"):
         analysis.closed_form_spectrum(0, "loop", crease=True)
+
+
+def test_figure_script_runs(tmp_path):
+    """docs/figures/make_figures.py, in its quick mode: the docs' figures can be regenerated."""
+    pytest.importorskip("matplotlib")
+    import importlib.util
+    import os
+
+    path = os.path.join(os.path.dirname(__file__), "..", "docs", "figures", "make_figures.py")
+    spec = importlib.util.spec_from_file_location("make_figures", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.main(["--out", str(tmp_path), "--quick"])
+    made = sorted(p.name for p in tmp_path.iterdir())
+    assert made == ["analysis_charmaps.png", "analysis_spectra.png", "features_fandisk.png",
+                    "limit_convergence.png", "limit_fandisk.png", "limit_octahedron.png"]
+    assert all((tmp_path / m).stat().st_size > 5000 for m in made)
