@@ -33,6 +33,10 @@ SEC_CORNER = 5  # corner: the two crease tangents
 SEC_FAN = 6  # the control fan's normal (fallback where nothing else applies and no refinement)
 SEC_TRANSIENT = 7  # refine locally
 
+#: Local levels after which the fan normal of a dart or mixed vertex of the hybrid scheme is
+#: taken (it has no tangent plane; the fan's normal moves by O(1/levels) per level).
+FAN_LEVELS = 16
+
 
 @dataclass(frozen=True, eq=False)
 class _Sectors:
@@ -298,19 +302,20 @@ def _sector_normals(level: Level, plan: _Plan, X: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------------------------------------
 
 
-def _estimate(level: Level, sec: _Sectors, X: np.ndarray, sectors: np.ndarray, face_sharp: np.ndarray) -> np.ndarray:
-    """Normal estimate of sectors without stationary masks.
+def _estimate(level: Level, sec: _Sectors, X: np.ndarray, sectors: np.ndarray, face_sharp: np.ndarray):
+    """Normal estimate of sectors without stationary masks, and where it is the robust one.
 
-    Around such a vertex the runs of √3 (smooth) faces grow by one face per step. For each
-    run, with ring ``q_0 … q_r`` (``e_j = q_j − v``), ``(Σ e_j) × (Σ j e_j)`` has, up to one
-    common factor, the limit of the run's control fan area vector, and gets there
+    Between two crease edges the runs of √3 (smooth) faces grow by one face per step. For
+    each run, with ring ``q_0 … q_r`` (``e_j = q_j − v``), ``(Σ e_j) × (Σ j e_j)`` has, up to
+    one common factor, the limit of the run's control fan area vector, and gets there
     geometrically where the fan's own normal creeps (``docs/limit.md``); the runs' vectors
-    are summed. A sector without a √3 face (a Loop one, still transient) gets its fan normal.
-    Oriented like the fan normal.
+    are summed. Where a run goes (nearly) all the way round — darts, mixed vertices — ``Σ e_j``
+    nearly cancels and the estimate is unstable: those sectors, and sectors without a √3 face,
+    get the fan normal (``robust`` False). Oriented like the fan normal.
     """
     out = np.zeros((len(sectors), 3))
     if not len(sectors):
-        return out
+        return out, np.zeros(0, dtype=bool)
     fan = _fan_normals(level, sec, X)[sectors]
     nsec = len(sectors)
     k = sec.n_faces[sectors]
@@ -358,10 +363,12 @@ def _estimate(level: Level, sec: _Sectors, X: np.ndarray, sectors: np.ndarray, f
         run_sec = sid[start]
         np.add.at(out, run_sec, est)
     has_run = np.bincount(sid[smooth], minlength=nsec) > 0
-    out[~has_run] = fan[~has_run]
+    ends_differ = sec.ring[sec.ring_start[sectors]] != sec.ring[sec.ring_start[sectors + 1] - 1]
+    robust = has_run & op & ends_differ
+    out[~robust] = fan[~robust]
     flip = np.einsum("ij,ij->i", out, fan) < 0
     out[flip] *= -1.0
-    return _unit(out)
+    return _unit(out), robust
 
 
 def _refine_locally(level, tagged, face_sharp, corner, scheme, loop_weights, centers, plan0, X, want_rows,
@@ -513,8 +520,8 @@ def _refine_locally(level, tagged, face_sharp, corner, scheme, loop_weights, cen
             owner[cl[active]] = cidx[active]
             sec_c = owner[sec.vertex]  # centre index of each sector (−1: a rim vertex)
             mine = (sec_c >= 0) & need_nrm[np.maximum(sec_c, 0)]
-            value = np.where((plan.sec_kind != SEC_TRANSIENT)[:, None], _sector_normals(lvl, plan, Xl),
-                             _estimate(lvl, sec, Xl, np.arange(ns), fs))
+            est, robust = _estimate(lvl, sec, Xl, np.arange(ns), fs)
+            value = np.where((plan.sec_kind != SEC_TRANSIENT)[:, None], _sector_normals(lvl, plan, Xl), est)
             slot_sid = np.repeat(np.arange(ns), sec.n_faces)
             sel = mine[slot_sid]
             tgt = face_sec0[sec.slots[sel] // 3]
@@ -528,7 +535,11 @@ def _refine_locally(level, tagged, face_sharp, corner, scheme, loop_weights, cen
                           np.abs(nrm_est[tg] - nrm_prev[tg]).max(axis=1))
             settled = np.zeros(nc, dtype=bool)
             settled[active] = plan.settled[cl[active]]
-            done = need_nrm & active & (~still_moving | ((change < tol) & settled) | last)
+            # Fan normals (darts, mixed vertices) creep towards their limit like 1/levels:
+            # they stop after FAN_LEVELS levels (docs/limit.md).
+            uses_fan = np.bincount(sec_c[moving_sec & ~robust], minlength=nc) > 0
+            fan_done = uses_fan & (lev >= min(FAN_LEVELS, max_levels))
+            done = need_nrm & active & (~still_moving | (settled & ((change < tol) & ~uses_fan | fan_done)) | last)
             need_nrm[done] = False
             nrm_prev = nrm_est.copy()
         active = active & (need_pos | need_nrm)
@@ -794,6 +805,16 @@ def limit_normals(V, F, sharp_edges=None, *, levels=0, scheme="hybrid", sharpnes
                              False, tol, max_levels)
     N = np.zeros((s.level.n_vertices, 3))
     np.add.at(N, plan.sectors.vertex, nrm)
+    # Sectors facing opposite ways (a fin: a crease that turns back on itself) cancel; there
+    # the vertex gets its control fan's normal instead.
+    cancel = np.linalg.norm(N, axis=1) < 1e-6
+    if cancel.any():
+        Fl = s.level.faces
+        fn = np.cross(X[Fl[:, 1]] - X[Fl[:, 0]], X[Fl[:, 2]] - X[Fl[:, 0]])
+        fan = np.zeros_like(N)
+        for i in range(3):
+            np.add.at(fan, Fl[:, i], fn)
+        N[cancel] = fan[cancel]
     N = _unit(N)
     if per_face_corner:
         if s.same_level:

@@ -407,3 +407,22 @@ def test_bad_input():
         hybridsub.limit_positions(V, F, sharp_faces=[0])  # read-only arrays, no warning
     with pytest.warns(RuntimeWarning, match="did not converge"):
         hybridsub.limit_positions(V, F, sharp_faces=[0], max_levels=2)
+
+
+def test_dart_mixed_and_fin_normals():
+    # Darts and mixed vertices of the hybrid scheme: the control fan's normal after FAN_LEVELS
+    # local levels (no tangent plane there); stable, unit, on the side the faces face.
+    from hybridsub._limit import FAN_LEVELS
+    V, F = _sphere(1)
+    e = np.array([F[0, :2]])
+    for kw in ({"sharp_edges": e}, {"sharp_faces": np.arange(0, len(F), 3)}):
+        N = hybridsub.limit_normals(V, F, **kw)
+        assert np.allclose(np.linalg.norm(N, axis=1), 1)
+        assert (np.einsum("ij,ij->i", N, _vertex_normals(V, F)) > 0.9).all()
+        np.testing.assert_allclose(hybridsub.limit_normals(V, F, max_levels=FAN_LEVELS + 20, **kw), N, atol=1e-12)
+    # A crease that turns back on itself (a fin): its two sides face opposite ways; the vertex
+    # gets its control fan's normal rather than a zero vector.
+    V = np.array([[0, 0, 0], [1, 0.1, 0], [1, -0.1, 0], [0.5, 0, 1], [0.5, 0, -1]], float)
+    F = np.array([[0, 1, 3], [0, 3, 2], [0, 4, 1], [0, 2, 4], [1, 2, 3], [2, 1, 4]])
+    N = hybridsub.limit_normals(V, F, [[0, 1], [0, 2]], corners=[0], scheme="loop")
+    assert np.isclose(np.linalg.norm(N[0]), 1)
