@@ -680,7 +680,7 @@ def limit_matrix(F, sharp_edges=None, *, levels=0, n_vertices=None, scheme="hybr
     -------
     L : scipy.sparse.csr_matrix, (n_L, n)
         Limit positions of the level-``levels`` vertices are ``L @ V``. Rows are affine
-        (sum to 1) and non-negative.
+        (sum to 1) and non-negative (up to rounding where a row was extrapolated).
 
     Examples
     --------
