@@ -18,12 +18,14 @@ from ._facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges
 from ._features import Features, detect_features
 from ._interop import subdivide_mesh
 from ._io import TaggedMesh, read_mesh, write_mesh
+from ._limit import limit_matrix, limit_normals, limit_positions
 from ._refine import Refinement, RefinementStep, refine, subdivide
+from . import analysis
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
-    "FaceVaryingRefinement", "seam_edges",
+    "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
 ]
 __version__ = "0.1.0"

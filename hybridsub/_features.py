@@ -7,7 +7,6 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _validate as val
-from ._topology import build_level
 
 
 class Features(NamedTuple):
@@ -16,11 +15,14 @@ class Features(NamedTuple):
     Attributes
     ----------
     sharp_edges : (k, 2) int64
-        Interior edges whose dihedral angle exceeds the threshold.
+        Interior edges whose dihedral angle exceeds the threshold, in edge order (each
+        edge once, in the orientation of its first face).
     boundary_edges : (b, 2) int64
         Boundary edges (creases in ``"hybrid"`` and ``"loop"`` anyway).
     corners : (c,) int64
-        Vertices with three or more sharp or boundary edges.
+        Sorted vertex indices: vertices with three or more sharp or boundary edges, and
+        vertices where a crease line (two sharp or boundary edges) turns by more than
+        ``corner_angle``.
     """
 
     sharp_edges: np.ndarray
@@ -28,26 +30,63 @@ class Features(NamedTuple):
     corners: np.ndarray
 
 
-def detect_features(V, F, angle: float = 30.0) -> Features:
+def _check_angle(name, a):
+    try:
+        a = float(a)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a number of degrees, got {a!r}") from None
+    if not 0 <= a <= 180:
+        raise ValueError(f"{name} must be in [0, 180] degrees, got {a}")
+    return a
+
+
+def detect_features(V, F, angle: float = 30.0, *, corner_angle: float | None = 45.0) -> Features:
     """Find crease edges (dihedral angle above ``angle`` degrees) and corners.
 
-    The dihedral angle of an edge is the angle between the normals of its two faces
-    (0 for a flat edge). Degenerate faces (zero area) have no normal; their edges are not
-    reported as creases.
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    angle : float
+        An interior edge is sharp when the angle between the normals of its two faces (its
+        dihedral angle; 0 for a flat edge) exceeds this, in degrees.
+    corner_angle : float or None
+        A vertex on exactly two feature edges (sharp or boundary) is a corner when the crease
+        line turns there by more than this, in degrees: the angle between the two edges'
+        directions, 0 on a straight line. A crease that bends sharply is a corner, not a
+        crease vertex (the crease rule would round it off). ``None``: no such corners.
+
+    Returns
+    -------
+    Features
+        ``sharp_edges``, ``boundary_edges``, ``corners``.
+
+    Notes
+    -----
+    Degenerate faces (zero area) have no normal; their edges are not reported as creases.
+    Vertices with three or more feature edges are corners whatever their angles (the
+    scheme's own rule). The edges are those of the mesh as :func:`hybridsub.refine` sees
+    them (the same halfedge tables), so they can be passed on as they are.
 
     Examples
     --------
     >>> import hybridsub
     >>> V, F = hybridsub.load_example()
     >>> feat = hybridsub.detect_features(V, F, angle=30)
-    >>> len(feat.sharp_edges), len(feat.boundary_edges)
-    (722, 0)
+    >>> len(feat.sharp_edges), len(feat.boundary_edges), len(feat.corners)
+    (722, 0, 23)
     """
     Vf = val.as_vertices(V)
     Fi, n = val.as_faces(F, len(Vf))
-    if not 0 <= float(angle) <= 180:
-        raise ValueError(f"angle must be in [0, 180] degrees, got {angle}")
-    level = build_level(Fi, n)
+    angle = _check_angle("angle", angle)
+    if corner_angle is not None:
+        corner_angle = _check_angle("corner_angle", corner_angle)
+    if len(Fi) == 0:
+        empty = np.empty((0, 2), np.int64)
+        return Features(empty, empty.copy(), np.empty(0, np.int64))
+    level = val.checked_level(Fi, n)
     ev = level.edge_vertices
     owner = level.edge_owner
     twin = level.twin[owner]
@@ -62,6 +101,45 @@ def detect_features(V, F, angle: float = 30.0) -> Features:
     cos = np.einsum("ij,ij->i", normal[fa], normal[fb])
     sharp = np.zeros(len(ev), dtype=bool)
     sharp[interior] = (cos < np.cos(np.radians(angle))) & ok[fa] & ok[fb]
-    creases = ev[sharp | ~interior]
+    feature = sharp | ~interior
+    creases = ev[feature]
     count = np.bincount(creases.ravel(), minlength=n)
-    return Features(ev[sharp], ev[~interior], np.flatnonzero(count >= 3))
+    corner = count >= 3
+    if corner_angle is not None and len(creases):
+        # Turning angle at vertices with exactly two feature edges: the angle between the
+        # directions in and out, i.e. 180° minus the angle between the two edges at v.
+        ends = creases.ravel()
+        other = creases[:, ::-1].ravel()
+        two = count[ends] == 2
+        v, w = ends[two], other[two]
+        d = Vf[w] - Vf[v]
+        d = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), np.finfo(float).tiny)
+        order = np.argsort(v, kind="stable")
+        v, d = v[order], d[order]  # each vertex twice, consecutive
+        c = np.einsum("ij,ij->i", d[0::2], d[1::2])  # cos of the angle between the edges
+        turn = 180.0 - np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+        corner[v[0::2][turn > corner_angle]] = True
+    return Features(ev[sharp], ev[~interior], np.flatnonzero(corner))
+
+
+def merge_detected(V, F, angle, sharp_edges=None, sharpness=None, corners=None, *, corner_angle=45.0):
+    """Add the features detected at ``angle`` to the caller's tags (theirs take precedence).
+
+    Detected sharp edges that the caller already tagged keep the caller's sharpness; the
+    others are infinitely sharp. Corners are the union. Returns ``(sharp_edges, sharpness,
+    corners)`` for :func:`hybridsub.refine` (corners as indices).
+    """
+    Vf = val.as_vertices(V)
+    feat = detect_features(Vf, F, angle, corner_angle=corner_angle)
+    n = len(Vf)
+    pairs, s = val.as_sharp_edges(sharp_edges, sharpness, n)
+    found = feat.sharp_edges
+    if len(pairs):
+        key = np.sort(pairs, axis=1) @ np.array([n, 1], dtype=np.int64)
+        fkey = np.sort(found, axis=1) @ np.array([n, 1], dtype=np.int64)
+        found = found[~np.isin(fkey, key)]
+    pairs = np.concatenate([pairs, found])
+    s = np.concatenate([s, np.full(len(found), np.inf)])
+    cmask = val.as_corner_mask(corners, n)
+    cmask[feat.corners] = True
+    return pairs, s, np.flatnonzero(cmask)

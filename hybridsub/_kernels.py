@@ -95,13 +95,9 @@ def _prev(h):
 
 
 @njit(cache=True)
-def halfedge_twins(F, n_vertices):
-    """Twin of every halfedge (−1 on the boundary), and halfedges grouped by origin.
-
-    Returns (twin, by_origin, origin_start, error, h_bad): ``by_origin[origin_start[v]:
-    origin_start[v+1]]`` are the halfedges leaving v, in increasing order. ``error`` is OK or
-    an ERR_* code with the offending halfedge ``h_bad``.
-    """
+def group_by_origin(F, n_vertices):
+    """Halfedges grouped by origin vertex (a counting sort): ``by_origin[start[v]:start[v+1]]``
+    are the halfedges leaving v, in increasing order. Returns (by_origin, start)."""
     m = F.shape[0]
     nh = 3 * m
     start = np.zeros(n_vertices + 1, np.int64)
@@ -116,6 +112,19 @@ def halfedge_twins(F, n_vertices):
         u = F[h // 3, h % 3]
         by_origin[fill[u]] = h
         fill[u] += 1
+    return by_origin, start
+
+
+@njit(cache=True)
+def halfedge_twins(F, n_vertices):
+    """Twin of every halfedge (−1 on the boundary), and halfedges grouped by origin.
+
+    Returns (twin, by_origin, origin_start, error, h_bad), the middle two as
+    :func:`group_by_origin` gives them. ``error`` is OK or an ERR_* code with the offending
+    halfedge ``h_bad``.
+    """
+    nh = 3 * F.shape[0]
+    by_origin, start = group_by_origin(F, n_vertices)
     twin = np.full(nh, -1, np.int64)
     for h in range(nh):
         u = _origin(F, h)

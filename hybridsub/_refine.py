@@ -15,6 +15,7 @@ import scipy.sparse as sp
 from . import _budget
 from . import _repair
 from . import _validate as val
+from ._features import merge_detected
 from ._stencils import apply_matrix, apply_step, step_matrix
 from ._topology import child_creases, child_level, face_parents, plan_step
 
@@ -261,7 +262,8 @@ def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights,
 
 
 def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-              corners=None, loop_weights="loop", return_matrix=False, non_manifold="raise", max_memory=None):
+              corners=None, loop_weights="loop", return_matrix=False, feature_angle=None, non_manifold="raise",
+              max_memory=None):
     """Subdivide a triangle mesh, keeping its sharp features.
 
     Parameters
@@ -288,6 +290,9 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
         Smooth vertex weights in Loop regions.
     return_matrix : bool
         Also return the composite refinement matrix S (``V2 == S @ V``).
+    feature_angle : float, optional
+        Also tag what :func:`hybridsub.detect_features` finds at this dihedral angle (degrees):
+        its sharp edges (infinitely sharp, unless given in ``sharp_edges``) and corners.
     non_manifold : {"raise", "cut"}
         ``"cut"`` cuts the mesh along edges in three or more faces and along inconsistently
         oriented edges instead of raising; see :func:`refine`.
@@ -316,8 +321,12 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
     >>> V2, F2, S = hybridsub.subdivide(V, F, sharp_edges=[[0, 1]], return_matrix=True)
     >>> bool(np.allclose(S @ V, V2))
     True
+    >>> V, F = hybridsub.load_example()
+    >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, feature_angle=30)   # creases found and kept
     """
     Vf, out_dtype = val.as_vertices(V, return_dtype=True)
+    if feature_angle is not None:  # automatic features (docs/features.md)
+        sharp_edges, sharpness, corners = merge_detected(Vf, F, feature_angle, sharp_edges, sharpness, corners)
     if return_matrix or val.check_non_manifold(non_manifold) == "cut":
         r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,

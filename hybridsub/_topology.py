@@ -95,13 +95,25 @@ class Level:
     def valence(self) -> np.ndarray:
         return np.diff(self.ve_start)
 
+    @property
+    def by_origin(self) -> np.ndarray:
+        """(3m,) halfedges grouped by origin vertex (see ``origin_start``)."""
+        return self._origin_groups()[0]
+
+    @property
+    def origin_start(self) -> np.ndarray:
+        """(n + 1,) ``by_origin[origin_start[v]:origin_start[v+1]]`` leave vertex v."""
+        return self._origin_groups()[1]
+
+    def _origin_groups(self):
+        if self._by_origin is None:
+            self._by_origin = K.group_by_origin(self.faces, self.n_vertices)
+        return self._by_origin
+
     def find_halfedges(self, pairs: np.ndarray) -> np.ndarray:
         """A halfedge of each vertex pair's edge, −1 where the mesh has no such edge."""
-        if self._by_origin is None:
-            self._by_origin = _group_by_origin(self.faces, self.n_vertices)
-        by_origin, origin_start = self._by_origin
         pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
-        return K.find_halfedges(pairs, self.faces, by_origin, origin_start)
+        return K.find_halfedges(pairs, self.faces, self.by_origin, self.origin_start)
 
     def find_edges(self, pairs: np.ndarray) -> np.ndarray:
         """Edge index of each vertex pair, −1 where the mesh has no such edge."""
@@ -126,11 +138,6 @@ class Level:
             inner = t >= 0
             np.maximum.at(hsharp, t[inner], sharpness[inner])
         return Level(self.faces, self.n_vertices, self.twin, hsharp, face_sharp, self._by_origin)
-
-
-def _group_by_origin(F, n):
-    twin, by_origin, origin_start, err, h = K.halfedge_twins(F, n)
-    return by_origin, origin_start
 
 
 def build_level(faces: np.ndarray, n_vertices: int) -> Level:
