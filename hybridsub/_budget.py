@@ -32,6 +32,7 @@ import numpy as np
 from . import _rules as R
 from . import _stencils
 from ._errors import OutputTooLargeError
+from ._typing import MemoryLimit
 
 ENV_VAR = "HYBRIDSUB_MAX_MEMORY"
 DEFAULT_FRACTION = 0.8
@@ -75,7 +76,7 @@ def physical_memory() -> int | None:
         return None
 
 
-def set_memory_limit(limit) -> None:
+def set_memory_limit(limit: MemoryLimit) -> None:
     """Set the memory limit that ``refine`` and ``subdivide`` enforce, for this process.
 
     Parameters
@@ -97,7 +98,7 @@ def set_memory_limit(limit) -> None:
     _limit = None if limit is None else parse_limit(limit, "the memory limit")
 
 
-def get_memory_limit(max_memory=None) -> float:
+def get_memory_limit(max_memory: MemoryLimit = None) -> float:
     """The memory limit in force, in bytes (``inf`` if there is none).
 
     ``max_memory`` (a per-call value, as ``refine`` takes it) wins over

@@ -36,6 +36,7 @@ from ._errors import MeshError
 from ._refine import Refinement, RefinementStep
 from ._stencils import step_matrix
 from ._topology import Level, child_creases, child_level, face_parents, plan_step
+from ._typing import ArrayLike, LoopWeights, Scheme, UVMode
 
 UV_MODES = ("linear", "smooth")
 
@@ -63,7 +64,7 @@ class FaceVaryingRefinement(NamedTuple):
     uv: Refinement
 
 
-def seam_edges(F, FUV) -> np.ndarray:
+def seam_edges(F: ArrayLike, FUV: ArrayLike) -> np.ndarray:
     """Seams of a textured mesh: interior edges whose two faces disagree on the UV indices.
 
     Parameters
@@ -93,9 +94,11 @@ def seam_edges(F, FUV) -> np.ndarray:
     return level.edge_vertices[seam[level.edge_owner]]
 
 
-def refine_face_varying(F, FUV, sharp_edges=None, levels=1, *, n_vertices=None, n_uvs=None, scheme="hybrid",
-                        uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
-                        loop_weights="loop") -> FaceVaryingRefinement:
+def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+                        n_vertices: int | None = None, n_uvs: int | None = None, scheme: Scheme = "hybrid",
+                        uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
+                        sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                        loop_weights: LoopWeights = "loop") -> FaceVaryingRefinement:
     """Refine a mesh's connectivity together with its face-varying (UV) index mesh.
 
     Parameters
@@ -196,9 +199,11 @@ def refine_face_varying(F, FUV, sharp_edges=None, levels=1, *, n_vertices=None, 
     return FaceVaryingRefinement(geo, uv)
 
 
-def subdivide_face_varying(V, F, UV, FUV, sharp_edges=None, levels=1, *, scheme="hybrid", uv_mode="linear",
-                           sharpness=None, sharp_faces=None, corners=None, loop_weights="loop",
-                           return_matrix=False):
+def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: ArrayLike,
+                           sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = "hybrid",
+                           uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
+                           sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                           loop_weights: LoopWeights = "loop", return_matrix: bool = False) -> tuple:
     """Subdivide a textured triangle mesh: positions and UVs with seams, faces kept aligned.
 
     Parameters

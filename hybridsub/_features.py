@@ -7,6 +7,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _validate as val
+from ._typing import ArrayLike
 
 
 class Features(NamedTuple):
@@ -40,7 +41,8 @@ def _check_angle(name, a):
     return a
 
 
-def detect_features(V, F, angle: float = 30.0, *, corner_angle: float | None = 45.0) -> Features:
+def detect_features(V: ArrayLike, F: ArrayLike, angle: float = 30.0, *,
+                    corner_angle: float | None = 45.0) -> Features:
     """Find crease edges (dihedral angle above ``angle`` degrees) and corners.
 
     Parameters

@@ -5,10 +5,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from ._features import detect_features
 from ._refine import refine
+from ._typing import ArrayLike, LoopWeights, Scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -17,10 +17,10 @@ if TYPE_CHECKING:  # pragma: no cover
 METADATA_KEY = "hybridsub"
 
 
-def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: str = "hybrid",
+def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "hybrid",
                    sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
                    sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
-                   feature_angle: float | None = None, loop_weights: str = "loop") -> trimesh.Trimesh:
+                   feature_angle: float | None = None, loop_weights: LoopWeights = "loop") -> trimesh.Trimesh:
     """Subdivide a ``trimesh.Trimesh``, carrying its attributes and features along.
 
     Per-vertex data — colours, texture coordinates stored per vertex, every array in

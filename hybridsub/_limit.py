@@ -22,6 +22,7 @@ from . import _validate as val
 from ._errors import MeshError
 from ._refine import refine
 from ._topology import Level, build_level
+from ._typing import ArrayLike, LoopWeights, Scheme
 
 # How a sector's normal is found.
 SEC_SMOOTH = 0  # cos/sin tangent masks (Kobbelt and Loop smooth vertices)
@@ -652,8 +653,10 @@ def _features(V, F, feature_angle, sharp_edges, sharpness, corners):
     return merge_detected(V, F, feature_angle, sharp_edges, sharpness, corners)
 
 
-def limit_matrix(F, sharp_edges=None, *, levels=0, n_vertices=None, scheme="hybrid", sharpness=None,
-                 sharp_faces=None, corners=None, loop_weights="loop", tol=1e-12, max_levels=60):
+def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                 n_vertices: int | None = None, scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                 sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                 loop_weights: LoopWeights = "loop", tol: float = 1e-12, max_levels: int = 60) -> sp.csr_matrix:
     """The limit matrix: where every vertex of a level goes when refined forever.
 
     Parameters
@@ -705,8 +708,11 @@ def limit_matrix(F, sharp_edges=None, *, levels=0, n_vertices=None, scheme="hybr
     return out
 
 
-def limit_positions(V, F, sharp_edges=None, *, levels=0, scheme="hybrid", sharpness=None, sharp_faces=None,
-                    corners=None, loop_weights="loop", feature_angle=None, tol=1e-12, max_levels=60):
+def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                    scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                    sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                    loop_weights: LoopWeights = "loop", feature_angle: float | None = None, tol: float = 1e-12,
+                    max_levels: int = 60) -> np.ndarray:
     """Limit positions of a mesh's vertices: the points of the limit surface they converge to.
 
     Parameters
@@ -750,9 +756,11 @@ def limit_positions(V, F, sharp_edges=None, *, levels=0, scheme="hybrid", sharpn
     return np.ascontiguousarray(X[: s.n_keep], dtype=out_dtype)
 
 
-def limit_normals(V, F, sharp_edges=None, *, levels=0, scheme="hybrid", sharpness=None, sharp_faces=None,
-                  corners=None, loop_weights="loop", feature_angle=None, per_face_corner=False, tol=1e-10,
-                  max_levels=60):
+def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                  scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                  sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                  loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
+                  per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60) -> np.ndarray:
     """Unit normals of the limit surface at the limit positions of a mesh's vertices.
 
     Smooth vertices get the normal of the limit surface's tangent plane (Kobbelt's and

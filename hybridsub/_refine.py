@@ -18,6 +18,7 @@ from . import _validate as val
 from ._features import merge_detected
 from ._stencils import apply_matrix, apply_step, step_matrix
 from ._topology import child_creases, child_level, face_parents, plan_step
+from ._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,7 +104,7 @@ class Refinement:
             self._cache["matrix"] = S
         return self._cache["matrix"]
 
-    def apply(self, X) -> np.ndarray:
+    def apply(self, X: ArrayLike) -> np.ndarray:
         """Refine per-vertex data: positions, UVs, colours, any (n_coarse, ...) array.
 
         Floating-point data keeps its dtype (computed in float64); other data comes back as
@@ -136,9 +137,10 @@ class Refinement:
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
 
 
-def refine(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
-           sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise",
-           max_memory=None) -> Refinement:
+def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *, n_vertices: int | None = None,
+           scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+           corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+           non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -261,9 +263,13 @@ def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights,
         level = child
 
 
-def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-              corners=None, loop_weights="loop", return_matrix=False, feature_angle=None, non_manifold="raise",
-              max_memory=None):
+def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+              scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+              corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
+              feature_angle: float | None = None, non_manifold: NonManifold = "raise",
+              max_memory: MemoryLimit = None,
+              ) -> tuple[NDArray[np.floating], NDArray[np.int64]] | tuple[NDArray[np.floating], NDArray[np.int64],
+                                                                          sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
     Parameters
@@ -333,14 +339,14 @@ def subdivide(V, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=No
                    non_manifold=non_manifold, max_memory=max_memory)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
-    X = faces = None
-    for out in subdivide_levels(Vf, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
-                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False,
-                                max_memory=max_memory):
-        X, faces = out.X, out.faces
-    if X is None:  # no step ran: copies of the input
-        X, faces = Vf.copy(), val.as_faces(F, len(Vf))[0].copy()
-    return X.astype(out_dtype, copy=False), faces
+    last = None
+    for last in subdivide_levels(Vf, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
+                                 sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False,
+                                 max_memory=max_memory):
+        pass
+    if last is None:  # no step ran: copies of the input
+        return Vf.astype(out_dtype, copy=True), val.as_faces(F, len(Vf))[0].copy()
+    return last.X.astype(out_dtype, copy=False), last.faces
 
 
 @dataclass(frozen=True, eq=False)
