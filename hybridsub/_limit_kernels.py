@@ -16,20 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True, inline="always")
-def _dest(F, h):
-    return F[h // 3, (h % 3 + 1) % 3]
-
-
-@njit(cache=True, inline="always")
-def _origin(F, h):
-    return F[h // 3, h % 3]
-
-
-@njit(cache=True, inline="always")
-def _prev(h):
-    return h - h % 3 + (h % 3 + 2) % 3
+from ._kernels import _dest, _origin, _prev
 
 
 @njit(cache=True)
