@@ -68,20 +68,22 @@ int main(int argc, char** argv) try {
 
     std::vector<double> times;
     std::size_t nv = 0, nf = 0;
+    long peak = -1;
     for (int r = 0; r < warmup + repeat; ++r) {
         SurfaceMesh sm = input;  // the copy is not timed
-        const double t0 = harness::now();
-        run(sm);
-        const double t1 = harness::now();
+        double t0 = 0, t1 = 0;
+        auto timed = [&] { t0 = harness::now(); run(sm); t1 = harness::now(); };
+        if (r == 0) peak = harness::peak_rss_growth(timed);  // the (untimed) warm-up run when warmup > 0
+        else timed();
         if (r >= warmup) times.push_back(t1 - t0);
         nv = sm.number_of_vertices();
         nf = sm.number_of_faces();
         if (r == warmup + repeat - 1 && !args.get("out").empty()) harness::write_off(args.get("out"), from_surface_mesh(sm));
     }
     std::printf("{\"peer\": \"CGAL %s Subdivision_method_3::%s\", \"scheme\": \"%s\", \"levels\": %d, "
-                "\"repeat\": %d, \"n_vertices\": %zu, \"n_faces\": %zu, %s}\n",
+                "\"repeat\": %d, \"n_vertices\": %zu, \"n_faces\": %zu, \"peak_rss_delta\": %ld, %s}\n",
                 CGAL_VERSION_STR, scheme == "sqrt3" ? "Sqrt3_subdivision" : "Loop_subdivision", scheme.c_str(),
-                levels, repeat, nv, nf, harness::json_timing("subdivide", times).c_str());
+                levels, repeat, nv, nf, peak, harness::json_timing("subdivide", times).c_str());
     return 0;
 } catch (const std::exception& e) {
     std::fprintf(stderr, "cgal_subdiv: %s\n", e.what());

@@ -107,6 +107,27 @@ inline std::string json_timing(const std::string& name, const std::vector<double
     return s.str();
 }
 
+// Linux: a /proc/self/status field ("VmRSS", "VmHWM") in bytes, or -1.
+inline long status_bytes(const std::string& key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind(key + ":", 0) == 0) return std::stol(line.substr(key.size() + 1)) * 1024;
+    return -1;
+}
+
+// Peak RSS growth of f(): VmHWM is reset to the current RSS first (/proc/self/clear_refs, the
+// method compare.py uses for hybridsub); -1 where that is not possible.
+template <class Fn>
+long peak_rss_growth(Fn&& f) {
+    std::ofstream reset("/proc/self/clear_refs");
+    const bool ok = bool(reset << "5" << std::flush);
+    const long before = status_bytes("VmRSS");
+    f();
+    const long peak = status_bytes("VmHWM");
+    return ok && before >= 0 && peak >= 0 ? peak - before : -1;
+}
+
 // Minimal argv parsing: positional arguments and --key value options.
 struct Args {
     std::vector<std::string> pos;

@@ -76,21 +76,29 @@ int main(int argc, char** argv) try {
                                     reinterpret_cast<const Point*>(mesh.V.data()) + mesh.n_vertices());
     std::vector<double> t_create, t_refine, t_interp, t_total;
     long nv = 0, nf = 0;
+    long peak = -1;
     for (int r = 0; r < warmup + repeat; ++r) {
-        const double t0 = harness::now();
-        std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, options));
-        if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
-        const double t1 = harness::now();
-        refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(levels));
-        const double t2 = harness::now();
-        Far::PrimvarRefinerReal<double> primvar(*refiner);
-        std::vector<Point> src = coarse;  // a copy of the input: the caller's buffer is not overwritten
-        for (int level = 1; level <= levels; ++level) {
-            std::vector<Point> dst(refiner->GetLevel(level).GetNumVertices());
-            primvar.Interpolate(level, src, dst);
-            src.swap(dst);
-        }
-        const double t3 = harness::now();
+        std::unique_ptr<Far::TopologyRefiner> refiner;
+        std::vector<Point> src;
+        double t0 = 0, t1 = 0, t2 = 0, t3 = 0;
+        auto timed = [&] {
+            t0 = harness::now();
+            refiner.reset(Factory::Create(desc, options));
+            if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+            t1 = harness::now();
+            refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(levels));
+            t2 = harness::now();
+            Far::PrimvarRefinerReal<double> primvar(*refiner);
+            src = coarse;  // a copy of the input: the caller's buffer is not overwritten
+            for (int level = 1; level <= levels; ++level) {
+                std::vector<Point> dst(refiner->GetLevel(level).GetNumVertices());
+                primvar.Interpolate(level, src, dst);
+                src.swap(dst);
+            }
+            t3 = harness::now();
+        };
+        if (r == 0) peak = harness::peak_rss_growth(timed);  // the (untimed) warm-up run when warmup > 0
+        else timed();
         if (r >= warmup) {
             t_create.push_back(t1 - t0);
             t_refine.push_back(t2 - t1);
@@ -111,9 +119,9 @@ int main(int argc, char** argv) try {
         }
     }
     std::printf("{\"peer\": \"OpenSubdiv %d.%d.%d Far Loop\", \"scheme\": \"loop\", \"levels\": %d, \"repeat\": %d, "
-                "\"n_creases\": %zu, \"n_vertices\": %ld, \"n_faces\": %ld, %s, %s, %s, %s}\n",
+                "\"n_creases\": %zu, \"n_vertices\": %ld, \"n_faces\": %ld, \"peak_rss_delta\": %ld, %s, %s, %s, %s}\n",
                 OPENSUBDIV_VERSION_MAJOR, OPENSUBDIV_VERSION_MINOR, OPENSUBDIV_VERSION_PATCH, levels, repeat,
-                sharpness.size(), nv, nf, harness::json_timing("subdivide", t_total).c_str(),
+                sharpness.size(), nv, nf, peak, harness::json_timing("subdivide", t_total).c_str(),
                 harness::json_timing("create", t_create).c_str(), harness::json_timing("refine", t_refine).c_str(),
                 harness::json_timing("interpolate", t_interp).c_str());
     return 0;
