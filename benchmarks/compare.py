@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
-import gc
 import importlib
 import importlib.metadata as _md
 import json
@@ -35,100 +34,21 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-DATA = os.path.join(HERE, "data")
-PEERS = os.path.join(HERE, "peers")
-if os.path.isdir(os.path.join(ROOT, "hybridsub")):  # benchmark the checkout this file lives in
-    sys.path.insert(0, ROOT)
+from _bench import HERE, ROOT, Timing, load, measure, tags  # noqa: E402  (puts this checkout's hybridsub first)
 
 import hybridsub  # noqa: E402
-from hybridsub._examples import example_path, read_off  # noqa: E402
+from hybridsub._examples import read_off  # noqa: E402
 
-
-# --------------------------------------------------------------------------- timing
-
-
-@dataclass
-class Timing:
-    """Times of the timed runs (seconds) and what the result looked like."""
-
-    times: list
-    counts: tuple | None = None  # (n_vertices, n_faces) of the result
-    extra: dict = field(default_factory=dict)
-
-    @property
-    def median(self) -> float:
-        return float(np.median(self.times))
-
-    @property
-    def min(self) -> float:
-        return float(np.min(self.times))
-
-    @property
-    def runs(self) -> int:
-        return len(self.times)
-
-
-def measure(prepare, run, *, repeat: int, budget: float, counts=None) -> Timing:
-    """Median-of-runs timing, the same for every contender.
-
-    ``prepare()`` builds the input outside the timed region; ``run(inp)`` is timed alone with
-    the garbage collector off. One untimed warm-up run comes first (JIT compilation, lazy
-    imports, first use of a library). If the warm-up shows that ``repeat`` runs would take
-    longer than ``budget`` seconds, fewer runs are made (at least one); the report shows how
-    many. Results are deleted before the next run.
-    """
-    inp = prepare()
-    gc.collect()
-    t0 = time.perf_counter()
-    out = run(inp)
-    warm = time.perf_counter() - t0
-    cnt = counts(out) if counts else None
-    del out, inp
-    n = repeat if warm * repeat <= budget else max(1, min(repeat, int(budget // max(warm, 1e-9))))
-    times = []
-    for _ in range(n):
-        inp = prepare()
-        gc.collect()
-        gc.disable()
-        try:
-            t0 = time.perf_counter()
-            out = run(inp)
-            t1 = time.perf_counter()
-        finally:
-            gc.enable()
-        del out, inp
-        times.append(t1 - t0)
-    return Timing(times, cnt)
+PEERS = os.path.join(HERE, "peers")
 
 
 def pair_counts(out) -> tuple:
     V, F = out[0], out[1]
     return (len(V), len(F))
-
-
-# --------------------------------------------------------------------------- meshes
-
-
-@dataclass
-class Mesh:
-    name: str
-    path: str
-    V: np.ndarray
-    F: np.ndarray
-    creases: np.ndarray  # dihedral angle > 30°
-    corners: np.ndarray
-
-
-def load_mesh(name: str, path: str) -> Mesh:
-    V, F = read_off(path)
-    feat = hybridsub.detect_features(V, F, angle=30)
-    return Mesh(name, path, V, F, feat.sharp_edges, feat.corners)
 
 
 # --------------------------------------------------------------------------- Python peers
@@ -349,23 +269,20 @@ def first_calls(repeat: int, cold_runs: int) -> list:
 
 MEMORY_CHILD = r"""
 import json, resource, sys, tracemalloc
+from _bench import load, tags
 import hybridsub
-from hybridsub._examples import read_off
-path, scheme, levels, tagged, tiny = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4] == "1", sys.argv[5]
+name, variant, levels = sys.argv[1], sys.argv[2], int(sys.argv[3])
 
 def status(key):  # bytes
     for line in open("/proc/self/status"):
         if line.startswith(key + ":"):
             return int(line.split()[1]) * 1024
 
-def arguments(V, F):
-    feat = hybridsub.detect_features(V, F, angle=30)
-    kw = dict(levels=levels, scheme=scheme, corners=feat.corners if scheme == "hybrid" else None)
-    return (V, F, feat.sharp_edges) if tagged else (V, F, None), kw if tagged else dict(levels=levels, scheme=scheme)
-
-a, kw = arguments(*read_off(tiny))
-hybridsub.subdivide(*a, **kw)  # loads (or compiles) the kernels on a tiny mesh: their memory is not the call's
-a, kw = arguments(*read_off(path))
+tiny = load("icosahedron")
+edges, kw = tags(tiny, variant)
+hybridsub.subdivide(tiny.V, tiny.F, edges, levels=levels, **kw)  # loads the kernels: their memory is not the call's
+m = load(name)
+edges, kw = tags(m, variant)
 try:
     with open("/proc/self/clear_refs", "w") as fh:
         fh.write("5")  # resets VmHWM to the current RSS
@@ -373,22 +290,23 @@ try:
 except OSError:
     method = "ru_maxrss after minus VmRSS before the call (peak not reset: an upper bound)"
 rss0 = status("VmRSS")
-V2, F2 = hybridsub.subdivide(*a, **kw)
+V2, F2 = hybridsub.subdivide(m.V, m.F, edges, levels=levels, **kw)
 peak = (status("VmHWM") if method.startswith("VmHWM") else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024) - rss0
 out = V2.nbytes + F2.nbytes
 del V2, F2
 tracemalloc.start()
-V2, F2 = hybridsub.subdivide(*a, **kw)
+V2, F2 = hybridsub.subdivide(m.V, m.F, edges, levels=levels, **kw)
 traced = tracemalloc.get_traced_memory()[1]
 tracemalloc.stop()
 print(json.dumps(dict(peak_rss=peak, traced=traced, output=out, method=method)))
 """
 
 
-def peak_memory(path: str, scheme: str, levels: int, tagged: bool) -> dict:
-    argv = [sys.executable, "-c", MEMORY_CHILD, path, scheme, str(levels), "1" if tagged else "0",
-            os.path.join(DATA, "icosahedron.off")]
-    r = subprocess.run(argv, env=_CHILD_ENV, capture_output=True, text=True)
+def peak_memory(mesh: str, variant: str, levels: int) -> dict:
+    """Peak RSS growth of one subdivide call in a fresh process (see MEMORY_CHILD)."""
+    env = dict(_CHILD_ENV, PYTHONPATH=os.pathsep.join([HERE, _CHILD_ENV["PYTHONPATH"]]))
+    r = subprocess.run([sys.executable, "-c", MEMORY_CHILD, mesh, variant, str(levels)], env=env,
+                       capture_output=True, text=True)
     if r.returncode:
         raise RuntimeError(f"memory child failed: {r.stderr[-1000:]}")
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -468,21 +386,17 @@ class Run:
         self.skipped: dict = {}
         self.T: dict = {}  # contender key -> Timing
         self.verify: list = []  # (contender key, what was compared, result)
-        self.arm = load_mesh("armadillo", os.path.join(DATA, "armadillo.off"))
-        self.fan = load_mesh("fandisk", example_path("fandisk"))
-        self.border = load_mesh("mesh_with_border", os.path.join(DATA, "mesh_with_border.off"))
+        self.arm, self.fan, self.border = load("armadillo"), load("fandisk"), load("mesh_with_border")
         self.py_peers = load_py_peers(self.skipped)
         self.cxx = build_cxx(self.skipped, rebuild=not args.no_build)
         self.versions = {p.dist: version(p.dist) for p in self.py_peers}
         if any(p.key == "pyvista" for p in self.py_peers):
             self.versions["pyvista"] = version("pyvista")
 
-    def ours(self, mesh, scheme, tagged=False, weights="loop", levels=None):
-        """hybridsub.subdivide on (V, F) with the mesh's 30° creases (and corners for hybrid) if tagged."""
-        kw = dict(levels=levels or self.L, scheme=scheme, loop_weights=weights)
-        if tagged and scheme == "hybrid":
-            kw["corners"] = mesh.corners
-        edges = mesh.creases if tagged else None
+    def ours(self, mesh, variant, weights="loop", levels=None):
+        """hybridsub.subdivide of (V, F), a variant of _bench.VARIANTS (30° creases where tagged)."""
+        edges, kw = tags(mesh, variant)
+        kw.update(levels=levels or self.L, loop_weights=weights)
         return lambda inp: hybridsub.subdivide(inp[0], inp[1], edges, **kw)
 
     def contenders(self) -> dict:
@@ -491,9 +405,9 @@ class Run:
             "ours sqrt3 arm": (arm, ours(arm, "sqrt3")),
             "ours loop arm": (arm, ours(arm, "loop")),
             "ours loop-warren arm": (arm, ours(arm, "loop", weights="warren")),
-            "ours hybrid fan": (fan, ours(fan, "hybrid", tagged=True)),
+            "ours hybrid fan": (fan, ours(fan, "hybrid")),
             "ours sqrt3 fan": (fan, ours(fan, "sqrt3")),
-            "ours loop-creases fan": (fan, ours(fan, "loop", tagged=True)),
+            "ours loop-creases fan": (fan, ours(fan, "loop+creases")),
         }
 
     def time_ours(self):
@@ -531,7 +445,7 @@ class Run:
                 np.savetxt(creases, fan.creases, fmt="%d")
                 self._cxx_peer("osd loop-creases fan", [exe, fan.path, L, "--creases", creases],
                                [exe, fan.path, "2", "--creases", creases], fan,
-                               self.ours(fan, "loop", tagged=True, levels=2),
+                               self.ours(fan, "loop+creases", levels=2),
                                f"fandisk L2, {len(fan.creases)} creases vs ours loop + creases")
 
     def time_py_peers(self):
@@ -554,12 +468,12 @@ class Run:
     def time_apply(self) -> list:
         """r.apply(X) with the composite matrix formed, against S @ X and re-running subdivide."""
         rows = []
-        for label, mesh, scheme, tagged, rerun in (("armadillo loop", self.arm, "loop", False, "ours loop arm"),
-                                                   ("fandisk hybrid", self.fan, "hybrid", True, "ours hybrid fan")):
+        for label, mesh, variant, rerun in (("armadillo loop", self.arm, "loop", "ours loop arm"),
+                                            ("fandisk hybrid", self.fan, "hybrid", "ours hybrid fan")):
             log(f"timing composite matrix, {label} ...")
-            kw = dict(corners=mesh.corners) if tagged else {}
+            edges, kw = tags(mesh, variant)
             t0 = time.perf_counter()
-            r = hybridsub.refine(mesh.F, mesh.creases if tagged else None, self.L, scheme=scheme, **kw)
+            r = hybridsub.refine(mesh.F, edges, self.L, **kw)
             S = r.matrix
             pre = time.perf_counter() - t0
             for frames in (1, 100) if label.startswith("fandisk") else (1,):
@@ -586,11 +500,10 @@ class Run:
     def memory(self) -> list:
         log("measuring peak memory in fresh processes ...")
         rows = []
-        for label, mesh, scheme, tagged in (("armadillo sqrt3", self.arm, "sqrt3", False),
-                                            ("armadillo loop", self.arm, "loop", False),
-                                            ("fandisk hybrid (creases)", self.fan, "hybrid", True)):
+        for mesh, variant in (("armadillo", "sqrt3"), ("armadillo", "loop"), ("fandisk", "hybrid")):
+            label = f"{mesh} {variant}"
             try:
-                rows.append((label, peak_memory(mesh.path, scheme, self.L, tagged)))
+                rows.append((label, peak_memory(mesh, variant, self.L)))
             except Exception as e:
                 self.skipped[f"memory {label}"] = str(e)
         return rows

@@ -1,0 +1,154 @@
+"""What the benchmark scripts and suites share: the meshes, the variants, the timing loop."""
+
+from __future__ import annotations
+
+import gc
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+DATA = os.path.join(HERE, "data")
+if os.path.isdir(os.path.join(ROOT, "hybridsub")) and ROOT not in sys.path:
+    sys.path.insert(0, ROOT)  # benchmark the checkout this folder lives in, not an installed copy
+
+import hybridsub  # noqa: E402
+from hybridsub._examples import example_path, read_off  # noqa: E402
+
+MESHES = {
+    "icosahedron": os.path.join(DATA, "icosahedron.off"),
+    "fandisk": example_path("fandisk"),
+    "armadillo": os.path.join(DATA, "armadillo.off"),
+    "mesh_with_border": os.path.join(DATA, "mesh_with_border.off"),
+}
+
+
+@dataclass(frozen=True)
+class Mesh:
+    name: str
+    path: str
+    V: np.ndarray
+    F: np.ndarray
+    creases: np.ndarray  # edges with a dihedral angle above 30°
+    corners: np.ndarray
+
+
+_cache: dict = {}
+
+
+def load(name: str) -> Mesh:
+    if name not in _cache:
+        V, F = read_off(MESHES[name])
+        feat = hybridsub.detect_features(V, F, angle=30)
+        _cache[name] = Mesh(name, MESHES[name], V, F, feat.sharp_edges, feat.corners)
+    return _cache[name]
+
+
+# The schemes benchmarked: hybridsub's three, Loop both plain and with the 30° creases.
+VARIANTS = {
+    "sqrt3": dict(scheme="sqrt3"),
+    "loop": dict(scheme="loop"),
+    "loop+creases": dict(scheme="loop", tagged=True),
+    "hybrid": dict(scheme="hybrid", tagged=True),
+}
+
+
+def tags(mesh: Mesh, variant: str) -> tuple:
+    """(sharp_edges, keyword arguments) of a variant on a mesh."""
+    v = VARIANTS[variant]
+    if not v.get("tagged"):
+        return None, dict(scheme=v["scheme"])
+    kw = dict(scheme=v["scheme"])
+    if v["scheme"] == "hybrid":
+        kw["corners"] = mesh.corners
+    return mesh.creases, kw
+
+
+@dataclass
+class Timing:
+    """Times of the timed runs (seconds) and what the result looked like."""
+
+    times: list
+    counts: tuple | None = None  # (n_vertices, n_faces) of the result
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def median(self) -> float:
+        return float(np.median(self.times))
+
+    @property
+    def min(self) -> float:
+        return float(np.min(self.times))
+
+    @property
+    def runs(self) -> int:
+        return len(self.times)
+
+
+def measure(prepare, run, *, repeat: int, budget: float, counts=None) -> Timing:
+    """Median-of-runs timing, the same for every contender.
+
+    ``prepare()`` builds the input outside the timed region; ``run(inp)`` is timed alone with
+    the garbage collector off. One untimed warm-up run comes first (JIT compilation, lazy
+    imports, first use of a library). If the warm-up shows that ``repeat`` runs would take
+    longer than ``budget`` seconds, fewer runs are made (at least one); the report shows how
+    many. Results are deleted before the next run.
+    """
+    inp = prepare()
+    gc.collect()
+    t0 = time.perf_counter()
+    out = run(inp)
+    warm = time.perf_counter() - t0
+    cnt = counts(out) if counts else None
+    del out, inp
+    n = repeat if warm * repeat <= budget else max(1, min(repeat, int(budget // max(warm, 1e-9))))
+    times = []
+    for _ in range(n):
+        inp = prepare()
+        gc.collect()
+        gc.disable()
+        try:
+            t0 = time.perf_counter()
+            out = run(inp)
+            t1 = time.perf_counter()
+        finally:
+            gc.enable()
+        del out, inp
+        times.append(t1 - t0)
+    return Timing(times, cnt)
+
+
+def run_warm(benchmark, fn, *, prepare=None, budget: float = 2.0, min_rounds: int = 3, max_rounds: int = 20) -> None:
+    """Benchmark ``fn(*prepare())`` (``fn()`` without prepare) the way compare.py times it.
+
+    One untimed warm-up call (JIT compilation or cache load, first use), then rounds of one
+    call each; ``prepare`` runs before each round, untimed, and the round's result is deleted
+    in the (untimed) teardown, so at most one is alive. The number of rounds fits ``budget``
+    seconds, within [min_rounds, max_rounds]. If ``fn`` returns ``(V, F)``, their sizes go
+    into ``benchmark.extra_info``.
+    """
+    args = prepare() if prepare else ()
+    t0 = time.perf_counter()
+    out = fn(*args)
+    warm = time.perf_counter() - t0
+    if isinstance(out, tuple) and len(out) == 2 and all(isinstance(a, np.ndarray) for a in out):
+        benchmark.extra_info.update(vertices=len(out[0]), faces=len(out[1]), output_bytes=out[0].nbytes + out[1].nbytes)
+    del out, args
+    rounds = int(min(max_rounds, max(min_rounds, budget // max(warm, 1e-9))))
+    box = []
+
+    def setup():
+        gc.collect()
+        return (prepare(), {}) if prepare else None
+
+    def target(*args):
+        box.append(fn(*args))
+
+    def teardown(*args):
+        box.clear()
+
+    benchmark.pedantic(target, setup=setup, teardown=teardown, rounds=rounds, iterations=1, warmup_rounds=0)
