@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gc
 import os
+import platform
 import sys
 import time
 from dataclasses import dataclass, field
@@ -66,6 +67,15 @@ def tags(mesh: Mesh, variant: str) -> tuple:
     if v["scheme"] == "hybrid":
         kw["corners"] = mesh.corners
     return mesh.creases, kw
+
+
+def cpu_name() -> str:
+    """The CPU's model name (Linux), else what platform knows."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            return next((ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")), "?")
+    except OSError:
+        return platform.processor() or platform.machine()
 
 
 @dataclass

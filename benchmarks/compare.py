@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from _bench import HERE, ROOT, Timing, load, measure, tags  # noqa: E402  (puts this checkout's hybridsub first)
+from _bench import HERE, ROOT, Timing, cpu_name, load, measure, tags  # noqa: E402  (puts this checkout's hybridsub first)
 
 import hybridsub  # noqa: E402
 from hybridsub._examples import read_off  # noqa: E402
@@ -166,6 +166,8 @@ def build_cxx(skipped: dict, rebuild: bool) -> dict:
     found = {}
     for name in ("cgal_subdiv", "osd_loop"):
         exe = os.path.join(PEERS, "bin", name)
+        if name in skipped:  # the build skipped or failed it: an old binary is not used
+            continue
         if os.access(exe, os.X_OK):
             found[name] = exe
         else:
@@ -330,12 +332,6 @@ def fmt_mb(b: float) -> str:
 
 
 def machine_lines(args, versions: dict, load_at_start) -> list:
-    cpu = "?"
-    try:
-        with open("/proc/cpuinfo") as fh:
-            cpu = next((ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")), "?")
-    except OSError:
-        pass
     mem = "?"
     try:
         with open("/proc/meminfo") as fh:
@@ -350,7 +346,7 @@ def machine_lines(args, versions: dict, load_at_start) -> list:
     threads = {k: os.environ[k] for k in ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS") if k in os.environ}
     return [
         f"- date: {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}",
-        f"- machine: {cpu}, {os.cpu_count()} logical CPUs, {mem} RAM, {platform.system()} {platform.release()}",
+        f"- machine: {cpu_name()}, {os.cpu_count()} logical CPUs, {mem} RAM, {platform.system()} {platform.release()}",
         f"- load average (1, 5, 15 min) at start: {' '.join(f'{x:.2f}' for x in load_at_start)}; "
         f"at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}",
         f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {version('scipy')}, Numba {version('numba')}",

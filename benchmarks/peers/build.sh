@@ -13,6 +13,12 @@ flags="-O2 -DNDEBUG -std=c++17"
 force=0; [ "${1:-}" = "--force" ] && force=1
 status=0
 
+if ! command -v "$cxx" >/dev/null 2>&1; then
+    echo "skip cgal_subdiv: no C++ compiler ($cxx)"
+    echo "skip osd_loop: no C++ compiler ($cxx)"
+    exit 0
+fi
+
 has_header() { echo "#include <$1>" | "$cxx" -std=c++17 -x c++ -fsyntax-only - >/dev/null 2>&1; }
 
 build() {  # build NAME HEADER LIBS...
