@@ -5,6 +5,7 @@ from __future__ import annotations
 import gc
 import os
 import platform
+import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
@@ -67,6 +68,36 @@ def tags(mesh: Mesh, variant: str) -> tuple:
     if v["scheme"] == "hybrid":
         kw["corners"] = mesh.corners
     return mesh.creases, kw
+
+
+# The first call a user makes, for the fresh-process timings (compare.py, test_bench_compile.py).
+FIRST_CALL = {
+    "hybrid": "import hybridsub\n"
+              "V, F = hybridsub.load_example(); feat = hybridsub.detect_features(V, F, angle=30)\n"
+              "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, corners=feat.corners)\n",
+    "every-scheme": "import hybridsub\n"
+                    "V, F = hybridsub.load_example(); feat = hybridsub.detect_features(V, F, angle=30)\n"
+                    "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, corners=feat.corners)\n"
+                    "hybridsub.subdivide(V, F, levels=1, scheme='sqrt3')\n"
+                    "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, scheme='loop')\n",
+}
+
+
+def child_env(**extra) -> dict:
+    """The environment of a child Python: this checkout (and benchmarks/) first on its path."""
+    path = [ROOT, HERE] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(path), **extra)
+
+
+def fresh_process(code: str, cache_dir: str) -> float:
+    """Wall time of ``python -c CODE`` with NUMBA_CACHE_DIR=cache_dir, interpreter start included."""
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-c", code], env=child_env(NUMBA_CACHE_DIR=cache_dir), capture_output=True,
+                       text=True)
+    dt = time.perf_counter() - t0
+    if r.returncode:
+        raise RuntimeError(f"python -c failed:\n{code}\n{r.stderr[-1000:]}")
+    return dt
 
 
 def cpu_name() -> str:

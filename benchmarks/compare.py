@@ -35,12 +35,13 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from _bench import HERE, ROOT, Timing, cpu_name, load, measure, tags  # noqa: E402  (puts this checkout's hybridsub first)
+from _bench import FIRST_CALL, HERE, ROOT, Timing, child_env, cpu_name, fresh_process, load, measure, tags  # noqa: E402
 
-import hybridsub  # noqa: E402
+import hybridsub  # noqa: E402  (_bench put this checkout's package first)
 from hybridsub._examples import read_off  # noqa: E402
 
 PEERS = os.path.join(HERE, "peers")
@@ -60,11 +61,11 @@ class PyPeer:
 
     key: str
     label: str
-    dist: str  # distribution name, for the version (shown as `key version`)
-    weights: str  # "loop" (Loop's beta) or "warren" (Warren's beta); checked by verify_py_peer
-    prepare: object  # (V, F) -> native input
-    run: object  # (native input, levels) -> native output
-    arrays: object  # native output -> (V, F) NumPy arrays
+    dist: str  # distribution whose version the report gives
+    weights: str  # "loop" (Loop's beta) or "warren" (Warren's beta); Run.time_py_peers checks it
+    prepare: Callable  # (V, F) -> native input
+    run: Callable  # (native input, levels) -> native output
+    arrays: Callable  # native output -> (V, F) NumPy arrays
     note: str = ""
 
 
@@ -224,48 +225,27 @@ def agreement(V, F, Vref, Fref) -> str:
 
 # --------------------------------------------------------------------------- fresh processes
 
-_CHILD_ENV = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
-
-FIRST_CALL = {
-    "import hybridsub": "import hybridsub",
-    "first call: import + load_example + detect_features + hybrid L1 (README)": (
-        "import hybridsub\n"
-        "V, F = hybridsub.load_example(); feat = hybridsub.detect_features(V, F, angle=30)\n"
-        "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, corners=feat.corners)\n"),
-    "every scheme: import + hybrid, sqrt3, loop (creases) L1": (
-        "import hybridsub\n"
-        "V, F = hybridsub.load_example(); feat = hybridsub.detect_features(V, F, angle=30)\n"
-        "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, corners=feat.corners)\n"
-        "hybridsub.subdivide(V, F, levels=1, scheme='sqrt3')\n"
-        "hybridsub.subdivide(V, F, feat.sharp_edges, levels=1, scheme='loop')\n"),
+FIRST_CALL_LABELS = {
+    "hybrid": "first call: import + load_example + detect_features + hybrid L1 (README)",
+    "every-scheme": "every scheme: import + hybrid, sqrt3, loop (creases) L1",
 }
-
-
-def time_process(code: str, cache_dir: str) -> float:
-    env = dict(_CHILD_ENV, NUMBA_CACHE_DIR=cache_dir)
-    t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
-    dt = time.perf_counter() - t0
-    if r.returncode:
-        raise RuntimeError(f"child failed: {r.stderr[-1000:]}")
-    return dt
 
 
 def first_calls(repeat: int, cold_runs: int) -> list:
     """Wall time of `python -c CODE` (interpreter start included) with a warm and an empty cache."""
-    rows = [("python -c pass (interpreter start)", Timing([time_process("pass", tempfile.gettempdir()) for _ in range(repeat)]), None)]
-    for label, code in FIRST_CALL.items():
+    tmp = tempfile.gettempdir()
+    rows = [("python -c pass (interpreter start)", Timing([fresh_process("pass", tmp) for _ in range(repeat)]), None)]
+    with tempfile.TemporaryDirectory(prefix="hybridsub-numba-") as cache:
+        rows.append(("import hybridsub", Timing([fresh_process("import hybridsub", cache) for _ in range(repeat)]), None))
+    for key, code in FIRST_CALL.items():
         with tempfile.TemporaryDirectory(prefix="hybridsub-numba-warm-") as warm_dir:
-            time_process(code, warm_dir)  # fills the cache
-            warm = Timing([time_process(code, warm_dir) for _ in range(repeat)])
-        cold = None
-        if label != "import hybridsub":
-            times = []
-            for _ in range(cold_runs):
-                with tempfile.TemporaryDirectory(prefix="hybridsub-numba-cold-") as cold_dir:
-                    times.append(time_process(code, cold_dir))
-            cold = Timing(times)
-        rows.append((label, warm, cold))
+            fresh_process(code, warm_dir)  # fills the cache
+            warm = Timing([fresh_process(code, warm_dir) for _ in range(repeat)])
+        times = []
+        for _ in range(cold_runs):
+            with tempfile.TemporaryDirectory(prefix="hybridsub-numba-cold-") as cold_dir:
+                times.append(fresh_process(code, cold_dir))
+        rows.append((FIRST_CALL_LABELS[key], warm, Timing(times)))
     return rows
 
 
@@ -306,8 +286,7 @@ print(json.dumps(dict(peak_rss=peak, traced=traced, output=out, method=method)))
 
 def peak_memory(mesh: str, variant: str, levels: int) -> dict:
     """Peak RSS growth of one subdivide call in a fresh process (see MEMORY_CHILD)."""
-    env = dict(_CHILD_ENV, PYTHONPATH=os.pathsep.join([HERE, _CHILD_ENV["PYTHONPATH"]]))
-    r = subprocess.run([sys.executable, "-c", MEMORY_CHILD, mesh, variant, str(levels)], env=env,
+    r = subprocess.run([sys.executable, "-c", MEMORY_CHILD, mesh, variant, str(levels)], env=child_env(),
                        capture_output=True, text=True)
     if r.returncode:
         raise RuntimeError(f"memory child failed: {r.stderr[-1000:]}")
