@@ -236,7 +236,8 @@ def first_calls(repeat: int, cold_runs: int) -> list:
     tmp = tempfile.gettempdir()
     rows = [("python -c pass (interpreter start)", Timing([fresh_process("pass", tmp) for _ in range(repeat)]), None)]
     with tempfile.TemporaryDirectory(prefix="hybridsub-numba-") as cache:
-        rows.append(("import hybridsub", Timing([fresh_process("import hybridsub", cache) for _ in range(repeat)]), None))
+        imports = Timing([fresh_process("import hybridsub", cache) for _ in range(repeat)])
+    rows.append(("import hybridsub", imports, None))
     for key, code in FIRST_CALL.items():
         with tempfile.TemporaryDirectory(prefix="hybridsub-numba-warm-") as warm_dir:
             fresh_process(code, warm_dir)  # fills the cache
@@ -273,7 +274,8 @@ except OSError:
     method = "ru_maxrss after minus VmRSS before the call (peak not reset: an upper bound)"
 rss0 = status("VmRSS")
 V2, F2 = hybridsub.subdivide(m.V, m.F, edges, levels=levels, **kw)
-peak = (status("VmHWM") if method.startswith("VmHWM") else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024) - rss0
+high = status("VmHWM") if method.startswith("VmHWM") else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+peak = high - rss0
 out = V2.nbytes + F2.nbytes
 del V2, F2
 tracemalloc.start()
@@ -322,13 +324,15 @@ def machine_lines(args, versions: dict, load_at_start) -> list:
                              text=True).stdout.strip() or "?"
     except OSError:
         rev = "?"
-    threads = {k: os.environ[k] for k in ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS") if k in os.environ}
+    threads = {k: os.environ[k] for k in ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+               if k in os.environ}
     return [
         f"- date: {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}",
         f"- machine: {cpu_name()}, {os.cpu_count()} logical CPUs, {mem} RAM, {platform.system()} {platform.release()}",
         f"- load average (1, 5, 15 min) at start: {' '.join(f'{x:.2f}' for x in load_at_start)}; "
         f"at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}",
-        f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {version('scipy')}, Numba {version('numba')}",
+        f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {version('scipy')}, "
+        f"Numba {version('numba')}",
         f"- hybridsub {hybridsub.__version__} from `{os.path.dirname(hybridsub.__file__)}` (git {rev})",
         "- peers: " + (", ".join(f"{k} {v}" for k, v in versions.items()) or "none"),
         f"- threads: {threads or 'library defaults'}; command: `{shlex.join(['python'] + sys.argv)}`",
@@ -453,7 +457,9 @@ class Run:
             pre = time.perf_counter() - t0
             for frames in (1, 100) if label.startswith("fandisk") else (1,):
                 # frames as one (n, 3 × frames) array; re-running subdivide = frames × its median
-                data = (lambda: mesh.V) if frames == 1 else (lambda: np.hstack([mesh.V + 1e-3 * k for k in range(frames)]))
+                def data(frames=frames, V=mesh.V):
+                    return V if frames == 1 else np.hstack([V + 1e-3 * k for k in range(frames)])
+
                 ours = measure(data, r.apply, repeat=self.R, budget=self.B)
                 floor = measure(data, lambda X, S=S: S @ X, repeat=self.R, budget=self.B)
                 rows.append((label, frames, S.shape, S.nnz, pre, ours, floor, self.T[rerun].median * frames))
@@ -495,8 +501,8 @@ class Run:
         note = "; ".join(filter(None, [note, self.check_note(peer_key)]))
         tgt = f"≤ {target}" if target else "—"
         if o is None or p is None:
-            return [work, fmt_t(o.median) if o else "—", fmt_t(o.min) if o else "—", peer_label, "skipped", "—", "—",
-                    tgt, "skipped", note]
+            ours = [fmt_t(o.median), fmt_t(o.min)] if o else ["—", "—"]
+            return [work, *ours, peer_label, "skipped", "—", "—", tgt, "skipped", note]
         ratio = o.median / p.median
         ok = "—" if target is None else ("pass" if ratio <= target else "**fail**")
         runs = f" ({p.runs} run{'s' if p.runs > 1 else ''})" if p.runs < self.R else ""
@@ -524,8 +530,8 @@ class Run:
                                 "ours loop-warren arm" if warren else "ours loop arm", p.label, f"{p.key} loop arm",
                                 None, p.note))
         rows += [
-            row(f"hybrid, {fan_w}", "ours hybrid fan", "OpenSubdiv Far Loop, same creases", "osd loop-creases fan", 0.33,
-                "different schemes (hybrid splits smooth faces 1→3)"),
+            row(f"hybrid, {fan_w}", "ours hybrid fan", "OpenSubdiv Far Loop, same creases", "osd loop-creases fan",
+                0.33, "different schemes (hybrid splits smooth faces 1→3)"),
             row(f"hybrid, {fan_w}", "ours hybrid fan", "ours sqrt3, same mesh", "ours sqrt3 fan", 1.5),
             row(f"loop + creases, {fan_w}", "ours loop-creases fan", "OpenSubdiv Far Loop, same creases",
                 "osd loop-creases fan", None, "the same output"),
@@ -551,7 +557,8 @@ class Run:
         for label, frames, shape, nnz, pre, o, floor, rerun in apply_rows:
             rows.append([f"{label} L{L}, {frames} frame{'s' if frames > 1 else ''}",
                          f"{shape[0]:,}×{shape[1]:,}, nnz {nnz:,}", fmt_t(pre), fmt_t(o.median), fmt_t(floor.median),
-                         f"{o.median / floor.median:.2f}", fmt_t(rerun) + (f" ({frames} × median)" if frames > 1 else ""),
+                         f"{o.median / floor.median:.2f}",
+                         fmt_t(rerun) + (f" ({frames} × median)" if frames > 1 else ""),
                          f"{o.median / rerun:.4f}", "≤ 0.1", "pass" if o.median / rerun <= 0.1 else "**fail**"])
         md += table(["work", "S", "refine + matrix (once)", "r.apply(X)", "S @ X (SciPy floor)", "apply / floor",
                      "re-running subdivide", "apply / re-run", "target", ""], rows)
@@ -576,7 +583,8 @@ class Run:
         rows = [[label, fmt_mb(m["output"]), fmt_mb(m["peak_rss"]), f"{m['peak_rss'] / m['output']:.2f}",
                  fmt_mb(m["traced"]), "≤ 3", "pass" if m["peak_rss"] / m["output"] <= 3 else "**fail**"]
                 for label, m in mem_rows]
-        md += table(["work", "output arrays", "peak RSS growth", "peak / output", "tracemalloc peak", "target", ""], rows)
+        md += table(["work", "output arrays", "peak RSS growth", "peak / output", "tracemalloc peak", "target", ""],
+                    rows)
         if mem_rows:
             md += ["", f"Method: {mem_rows[0][1]['method']}, around one call after the kernels were loaded on a tiny "
                        "mesh. tracemalloc sees NumPy's allocations only (not Numba's NRT), so it is a lower bound."]

@@ -50,7 +50,8 @@ static harness::Mesh from_surface_mesh(const SurfaceMesh& sm) {
 int main(int argc, char** argv) try {
     harness::Args args(argc, argv);
     if (args.pos.size() != 3) {
-        std::fprintf(stderr, "usage: cgal_subdiv MESH.off sqrt3|loop LEVELS [--repeat N] [--warmup W] [--out RESULT.off]\n");
+        std::fprintf(stderr, "usage: cgal_subdiv MESH.off sqrt3|loop LEVELS "
+                             "[--repeat N] [--warmup W] [--out RESULT.off]\n");
         return 2;
     }
     const std::string scheme = args.pos[1];
