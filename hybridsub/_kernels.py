@@ -253,7 +253,7 @@ def _sharpness(h, twin, hsharp, has_tags):
 
 
 @njit(cache=True)
-def classify_step(F, twin, hsharp, has_tags, face_sharp, force_split, scheme, odd, hkind, edge_point,
+def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, scheme, odd, hkind, edge_point,
                   face_point, trisected, counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
 
@@ -262,8 +262,9 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, force_split, scheme, od
     (first) point on its edge or −1; ``face_point`` (m,) likewise; ``trisected`` (m,) the
     local index of a face's trisected boundary halfedge or −1. ``counts`` (6, n), zeroed
     by the caller, receives per vertex: valence, incident edges with s > 0, with s > 1, with
-    0 < s ≤ 1, incident faces, incident sharp faces; ``s_frac`` (n,), zeroed, the sum of s
-    over edges with 0 < s ≤ 1. Returns the number of vertices of the next level.
+    0 < s ≤ 1, incident faces, incident sharp faces (the last two only if ``mixed``: some
+    faces are sharp and some not); ``s_frac`` (n,), zeroed, the sum of s over edges with
+    0 < s ≤ 1. Returns the number of vertices of the next level.
     """
     m = F.shape[0]
     n = counts.shape[1]
@@ -326,19 +327,22 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, force_split, scheme, od
             nxt += 1
         else:
             face_point[f] = -1
-        sh = 1 if face_sharp[f] else 0
-        for i in range(3):
-            v = F[f, i]
-            counts[4, v] += 1
-            counts[5, v] += sh
+        if mixed:
+            sh = 1 if face_sharp[f] else 0
+            for i in range(3):
+                v = F[f, i]
+                counts[4, v] += 1
+                counts[5, v] += sh
     return nxt
 
 
 @njit(cache=True)
-def vertex_coefficients(counts, s_frac, corner, weight_table, cs, cn, fix_boundary, coefficients):
+def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
+                        coefficients):
     """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
     parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
-    non-smooth vertex (Kobbelt's odd steps)."""
+    non-smooth vertex (Kobbelt's odd steps). ``region_of_all`` is every vertex's region when
+    the faces are all sharp or all smooth, −1 when the counts must decide."""
     n = counts.shape[1]
     for v in range(n):
         rp = vertex_rule(counts[1, v], corner[v])
@@ -346,7 +350,9 @@ def vertex_coefficients(counts, s_frac, corner, weight_table, cs, cn, fix_bounda
         if fix_boundary and rp != SMOOTH:
             rp = CORNER
             rc = CORNER
-        if counts[5, v] == 0:
+        if region_of_all >= 0:
+            region = region_of_all
+        elif counts[5, v] == 0:
             region = REGION_SQRT3
         elif counts[5, v] == counts[4, v]:
             region = REGION_LOOP
@@ -377,33 +383,44 @@ def _neighbour_coefficient(v, s, coef):
     return c
 
 
-def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out):
+def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks):
     """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
 
-    Old vertices gather from their neighbours in edge order (serially: rows are summed in
-    one fixed order); edge and face points, one row each, are computed in parallel.
+    Old vertices gather from their neighbours in edge order. ``chunks`` threads each take
+    one range of vertices and walk all edges, keeping their own vertices' terms, so every
+    vertex is summed in the same order whatever the number of threads. Edge and face
+    points, one row each, are computed in parallel.
     """
     n = coef.shape[1]
     k = X.shape[1]
     m = F.shape[0]
-    for v in range(n):
-        for j in range(k):
-            out[v, j] = coef[0, v] * X[v, j]
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = _origin(F, h)
-        w = _dest(F, h)
-        s = _sharpness(h, twin, hsharp, has_tags)
-        c = _neighbour_coefficient(u, s, coef)
-        if c != 0.0:
+    for c in prange(chunks):
+        lo = c * n // chunks
+        hi = (c + 1) * n // chunks
+        for v in range(lo, hi):
             for j in range(k):
-                out[u, j] += c * X[w, j]
-        c = _neighbour_coefficient(w, s, coef)
-        if c != 0.0:
-            for j in range(k):
-                out[w, j] += c * X[u, j]
+                out[v, j] = coef[0, v] * X[v, j]
+        for h in range(3 * m):
+            t = twin[h]
+            if t >= 0 and t < h:
+                continue
+            u = _origin(F, h)
+            w = _dest(F, h)
+            mine_u = lo <= u < hi
+            mine_w = lo <= w < hi
+            if not (mine_u or mine_w):
+                continue
+            s = _sharpness(h, twin, hsharp, has_tags)
+            if mine_u:
+                cu = _neighbour_coefficient(u, s, coef)
+                if cu != 0.0:
+                    for j in range(k):
+                        out[u, j] += cu * X[w, j]
+            if mine_w:
+                cw = _neighbour_coefficient(w, s, coef)
+                if cw != 0.0:
+                    for j in range(k):
+                        out[w, j] += cw * X[u, j]
     for h in prange(3 * m):
         r = edge_point[h]
         t = twin[h]

@@ -356,8 +356,8 @@ class LevelOutput:
     step: int
     X: np.ndarray  # (n_k, d) refined data
     faces: np.ndarray  # (m_k, 3)
-    face_parent: np.ndarray  # (m_k,) face of the previous level each face came from
-    sharp_edges: np.ndarray | None  # tags of this level (None unless tags=True)
+    face_parent: np.ndarray | None  # (m_k,) face of the previous level each face came from
+    sharp_edges: np.ndarray | None  # tags of this level (these four None unless tags=True)
     sharpness: np.ndarray | None
     sharp_faces: np.ndarray | None  # (m_k,) bool mask
 
@@ -368,8 +368,8 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
     (the command line's progress bar) or the propagated tags with the positions. ``X`` is
-    any (n, d) per-vertex data, already validated as float64. With ``tags=False`` the last
-    level's tags are not computed (nor its twins). ``max_memory`` as in :func:`subdivide`.
+    any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
+    tags nor face parents are computed (nor the last level's twins). ``max_memory`` as in :func:`subdivide`.
     """
     levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
         F, sharp_edges, levels, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
@@ -382,4 +382,4 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
             pairs, sharp = child_creases(level, plan)
             yield LevelOutput(k, X, faces, face_parents(offsets), pairs, sharp, child.face_sharp)
         else:
-            yield LevelOutput(k, X, faces, face_parents(offsets), None, None, None)
+            yield LevelOutput(k, X, faces, None, None, None, None)

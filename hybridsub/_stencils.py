@@ -9,6 +9,7 @@ bit.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 
@@ -40,8 +41,10 @@ def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:
     """``S @ X`` for (n, k) float64 data, without forming S."""
     X = np.ascontiguousarray(X, dtype=np.float64)
     out = np.empty((plan.n_new, X.shape[1]), np.float64)
-    kernel = K.apply_step if level.n_faces >= K.PARALLEL_MIN else K.apply_step_serial
-    kernel(X, *step_arguments(level, plan), out)
+    if level.n_faces >= K.PARALLEL_MIN:
+        K.apply_step(X, *step_arguments(level, plan), out, numba.get_num_threads())
+    else:
+        K.apply_step_serial(X, *step_arguments(level, plan), out, 1)
     return out
 
 

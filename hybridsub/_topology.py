@@ -211,13 +211,16 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     if force_split is not None and sqrt3:
         raise ValueError('scheme="sqrt3" flips every interior edge; forced splits need "hybrid" or "loop"')
     force = _EMPTY_B if force_split is None else np.ascontiguousarray(force_split, dtype=bool)
-    n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp, force,
-                            R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts,
+    n_sharp = int(np.count_nonzero(level.face_sharp))
+    mixed = 0 < n_sharp < m
+    region_of_all = -1 if mixed else (R.REGION_LOOP if n_sharp else R.REGION_SQRT3)
+    n_new = K.classify_step(F, twin, level.hsharp if has_tags else _EMPTY_F, has_tags, level.face_sharp, mixed,
+                            force, R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts,
                             s_frac)
     table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
-    K.vertex_coefficients(counts, s_frac, corner, table, cs, cn, sqrt3 and odd, coefficients)
+    K.vertex_coefficients(counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
     if sqrt3 and not odd:
         bnext, bprev = K.boundary_links(F, twin)
     else:
