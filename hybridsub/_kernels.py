@@ -125,24 +125,26 @@ def halfedge_twins(F, n_vertices):
     """
     nh = 3 * F.shape[0]
     by_origin, start = group_by_origin(F, n_vertices)
+    dest = np.empty(nh, np.int64)  # destination of by_origin[k], so every group scans contiguously
+    for k in range(nh):
+        dest[k] = _dest(F, by_origin[k])
     twin = np.full(nh, -1, np.int64)
-    for h in range(nh):
-        u = _origin(F, h)
-        w = _dest(F, h)
+    for u in range(n_vertices):
         for k in range(start[u], start[u + 1]):
-            g = by_origin[k]
-            if g != h and _dest(F, g) == w:
-                return twin, by_origin, start, ERR_SAME_DIRECTION, h
-        if twin[h] >= 0:
-            continue
-        for k in range(start[w], start[w + 1]):
-            g = by_origin[k]
-            if _dest(F, g) == u:
-                if twin[h] >= 0:
-                    return twin, by_origin, start, ERR_MULTIPLE_TWINS, h
-                twin[h] = g
-        if twin[h] >= 0:
-            twin[twin[h]] = h
+            w = dest[k]
+            h = by_origin[k]
+            for q in range(k + 1, start[u + 1]):
+                if dest[q] == w:
+                    return twin, by_origin, start, ERR_SAME_DIRECTION, h
+            if twin[h] >= 0:
+                continue
+            for q in range(start[w], start[w + 1]):
+                if dest[q] == u:
+                    g = by_origin[q]
+                    if twin[h] >= 0:
+                        return twin, by_origin, start, ERR_MULTIPLE_TWINS, h
+                    twin[h] = g
+                    twin[g] = h
     return twin, by_origin, start, OK, -1
 
 
