@@ -193,30 +193,6 @@ def number_edges(twin):
 
 
 @njit(cache=True)
-def vertex_edges(F, owner, n_vertices):
-    """Incident edges of every vertex as CSR (start, edges), in increasing edge order."""
-    ne = owner.shape[0]
-    start = np.zeros(n_vertices + 1, np.int64)
-    for e in range(ne):
-        h = owner[e]
-        start[_origin(F, h) + 1] += 1
-        start[_dest(F, h) + 1] += 1
-    for v in range(n_vertices):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
-    edges = np.empty(2 * ne, np.int64)
-    for e in range(ne):
-        h = owner[e]
-        a = _origin(F, h)
-        b = _dest(F, h)
-        edges[fill[a]] = e
-        fill[a] += 1
-        edges[fill[b]] = e
-        fill[b] += 1
-    return start, edges
-
-
-@njit(cache=True)
 def boundary_links(F, twin):
     """For each boundary halfedge, the next and previous boundary halfedges (−1 elsewhere).
 

@@ -77,23 +77,10 @@ class Level:
     def boundary_edge(self) -> np.ndarray:
         return self.twin[self.edge_owner] < 0
 
-    @cached_property
-    def _vertex_edges(self):
-        return K.vertex_edges(self.faces, self.edge_owner, self.n_vertices)
-
-    @property
-    def ve_start(self) -> np.ndarray:
-        """(n + 1,) CSR offsets of each vertex's incident edges in ``ve_edges``."""
-        return self._vertex_edges[0]
-
-    @property
-    def ve_edges(self) -> np.ndarray:
-        """Incident edges of each vertex, in increasing edge order."""
-        return self._vertex_edges[1]
-
     @property
     def valence(self) -> np.ndarray:
-        return np.diff(self.ve_start)
+        """(n,) number of distinct neighbours of each vertex."""
+        return np.bincount(self.edge_vertices.ravel(), minlength=self.n_vertices)
 
     @property
     def by_origin(self) -> np.ndarray:
