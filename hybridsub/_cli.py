@@ -87,20 +87,10 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
         S.append(s)
         sources.append(os.path.basename(a.sharp_edges))
     if a.sharp_faces is not None:
-        f = _io.read_list_file(a.sharp_faces, "face indices")
-        bad = (f < 0) | (f >= m)
-        if bad.any():
-            raise CLIError(f"{a.sharp_faces}: face {int(f[bad][0])} does not exist: {path} has {m:,} faces "
-                           f"(0-based: 0..{m - 1})")
-        SF.append(f)
+        SF.append(_read_indices(a.sharp_faces, "face", "faces", m, path))
         sources.append(os.path.basename(a.sharp_faces))
     if a.corners is not None:
-        c = _io.read_list_file(a.corners, "vertex indices")
-        bad = (c < 0) | (c >= n)
-        if bad.any():
-            raise CLIError(f"{a.corners}: vertex {int(c[bad][0])} does not exist: {path} has {n:,} vertices "
-                           f"(0-based: 0..{n - 1})")
-        C.append(c)
+        C.append(_read_indices(a.corners, "vertex", "vertices", n, path))
         sources.append(os.path.basename(a.corners))
     angle = a.feature_angle
     if angle is None and default_angle is not None and not E and not SF and not C:
@@ -135,6 +125,16 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     if n_boundary:
         parts.append(f"{_n(n_boundary, 'boundary edge')} (creases too)")
     return Features(edges, sharp, sf, c, f"features: {', '.join(parts)} — from {' + '.join(sources)}")
+
+
+def _read_indices(list_path: str, noun: str, plural: str, count: int, mesh_path: str) -> np.ndarray:
+    """Indices from a text file, each checked against the mesh's ``count`` faces or vertices."""
+    idx = _io.read_list_file(list_path, f"{noun} indices")
+    bad = (idx < 0) | (idx >= count)
+    if bad.any():
+        raise CLIError(f"{list_path}: {noun} {int(idx[bad][0])} does not exist: {mesh_path} has {count:,} "
+                       f"{plural} (0-based: 0..{count - 1})")
+    return idx
 
 
 def _check_edges(e, pairs, n, source, path):
