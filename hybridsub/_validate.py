@@ -24,15 +24,7 @@ def check_options(scheme, levels, loop_weights) -> int:
         raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
     if loop_weights not in R.LOOP_WEIGHTS:
         raise ValueError(f"loop_weights must be one of {R.LOOP_WEIGHTS}, got {loop_weights!r}")
-    if isinstance(levels, (bool, np.bool_)):
-        raise TypeError(f"levels must be a non-negative integer, got {levels!r}")
-    try:
-        levels = operator.index(levels)
-    except TypeError:
-        raise TypeError(f"levels must be a non-negative integer, got {levels!r}") from None
-    if levels < 0:
-        raise ValueError(f"levels must be a non-negative integer, got {levels}")
-    return levels
+    return _count(levels, "levels")
 
 
 NON_MANIFOLD = ("raise", "cut")

@@ -224,7 +224,12 @@ def grid(nx, ny, diagonals, *, z=None):
     I, J = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
     Z = np.zeros_like(I, dtype=float) if z is None else np.asarray(z, float)
     V = np.stack([I.ravel(), J.ravel(), Z.ravel()], axis=1).astype(float)
-    idx = lambda i, j: i * (ny + 1) + j  # noqa: E731
+    F = _split_quads(nx, ny, lambda i, j: i * (ny + 1) + j, diagonals)
+    return _mesh(V, F)
+
+
+def _split_quads(nx, ny, idx, diagonals):
+    """Two triangles per grid quad (i, j), split along the diagonal ``diagonals[i, j]`` picks."""
     F = []
     diagonals = np.asarray(diagonals, bool).reshape(nx, ny)
     for i in range(nx):
@@ -234,7 +239,7 @@ def grid(nx, ny, diagonals, *, z=None):
                 F += [[a, b, d], [b, c, d]]
             else:
                 F += [[a, b, c], [a, c, d]]
-    return _mesh(V, np.array(F))
+    return np.array(F)
 
 
 def torus(nu, nv, diagonals=None, R=2.0, r=0.7):
@@ -246,16 +251,7 @@ def torus(nu, nv, diagonals=None, R=2.0, r=0.7):
     U, W = np.meshgrid(u, v, indexing="ij")
     V = np.stack([(R + r * np.cos(W)) * np.cos(U), (R + r * np.cos(W)) * np.sin(U),
                   r * np.sin(W)], axis=2).reshape(-1, 3)
-    idx = lambda i, j: (i % nu) * nv + (j % nv)  # noqa: E731
-    F = []
-    for i in range(nu):
-        for j in range(nv):
-            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
-            if diagonals[i, j]:
-                F += [[a, b, d], [b, c, d]]
-            else:
-                F += [[a, b, c], [a, c, d]]
-    return _mesh(V, np.array(F))
+    return _mesh(V, _split_quads(nu, nv, lambda i, j: (i % nu) * nv + (j % nv), diagonals))
 
 
 def fan(valence, *, closed, height=0.0):
