@@ -52,7 +52,10 @@ def compare_panels(V, F, levels: int, *, sharp_edges=None, sharpness=None, sharp
 
 def render_figure(panels: list[Panel], path: str, *, width: int = 1600, height: int = 520,
                   view: tuple[float, float] | None = None, title: str | None = None) -> tuple[float, float]:
-    """Render the panels side by side into a ``width`` × ``height`` PNG; returns the view used."""
+    """Render the panels side by side into a ``width`` × ``height`` PNG; returns the view used.
+
+    All panels share one scale and view (chosen on the first panel unless ``view`` is given),
+    fitted so that every panel shows whole."""
     try:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -60,7 +63,8 @@ def render_figure(panels: list[Panel], path: str, *, width: int = 1600, height: 
         raise ImportError("the figure needs matplotlib: python -m pip install 'hybridsub[plot]' "
                           "(or python -m pip install matplotlib)") from None
     ref = panels[0]
-    center = (ref.V.min(axis=0) + ref.V.max(axis=0)) / 2
+    allV = np.vstack([p.V for p in panels])  # one frame for all panels, big enough for each
+    center = (allV.min(axis=0) + allV.max(axis=0)) / 2
     if view is None:
         view = _render.choose_view(ref.V, ref.F, ref.lines)
     R = _render.view_rotation(*view)
@@ -70,7 +74,7 @@ def render_figure(panels: list[Panel], path: str, *, width: int = 1600, height: 
     pw, ph = width // k, height - label - top
     if pw < 16 or ph < 16:
         raise ValueError(f"a {width}x{height} figure leaves no room for {k} panels")
-    frame = _render.fit(ref.V - center, R, pw, ph)
+    frame = _render.fit(allV - center, R, pw, ph)
     dpi = 100
     fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, facecolor="white")
     FigureCanvasAgg(fig)

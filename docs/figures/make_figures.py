@@ -1,4 +1,4 @@
-"""Regenerate the figures of docs/features.md, docs/limit.md and docs/analysis.md.
+"""Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md and docs/semisharp.md.
 
 usage: python docs/figures/make_figures.py [--out DIR] [--quick]
 
@@ -301,13 +301,50 @@ def fig_charmaps(out, quick):
     _save(fig, os.path.join(out, "analysis_charmaps.png"), 80)
 
 
+def _box():
+    """The 12-triangle cube (trimesh's box): coarse, so that every level shows."""
+    import trimesh
+    m = trimesh.creation.box()
+    return np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces, dtype=np.int64)
+
+
+def fig_semisharp(out, quick):
+    # The same cube, its 12 edges creased with sharpness 0.5, 1, 2, 3 and inf: hybrid (top)
+    # and Loop (bottom, OpenSubdiv's uniform creasing), 5 levels each.
+    from PIL import Image
+
+    from hybridsub._figure import Panel, render_figure
+
+    V, F = _box()
+    E = hybridsub.detect_features(V, F, angle=30).sharp_edges
+    levels = 3 if quick else 5
+    rows = []
+    for scheme, name in (("hybrid", "hybrid √3–Loop"), ("loop", "Loop")):
+        panels = []
+        for s in (0.5, 1, 2, 3, np.inf):
+            r = hybridsub.refine(F, E, levels, n_vertices=len(V), scheme=scheme, sharpness=np.full(len(E), s))
+            panels.append(Panel(f"s = {s:g}" if np.isfinite(s) else "s = ∞ (sharp)", r.apply(V), r.faces,
+                                f"{len(r.faces):,} faces"))
+        path = os.path.join(out, f"_semisharp_{scheme}.png")
+        w = 1000 if quick else 1500
+        render_figure(panels, path, width=w, height=w * 33 // 100,
+                      title=f"{name}, {levels} levels, the cube's 12 edges creased with sharpness s")
+        rows.append(Image.open(path).convert("RGB"))
+        os.remove(path)
+    img = Image.new("RGB", (rows[0].width, sum(r.height for r in rows)), "white")
+    img.paste(rows[0], (0, 0))
+    img.paste(rows[1], (0, rows[0].height))
+    img.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).save(
+        os.path.join(out, "semisharp_cube.png"), optimize=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=HERE)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps):
+    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp):
         t = time.time()
         f(args.out, args.quick)
         print(f"{f.__name__}: {time.time() - t:.1f} s", file=sys.stderr)
