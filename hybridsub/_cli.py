@@ -62,7 +62,8 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     pairs, _, cnt = _edges(mesh.faces, n)
     n_boundary = int((cnt == 1).sum())
     explicit = [o for o, v in (("--sharp-edges", a.sharp_edges), ("--sharp-faces", a.sharp_faces),
-                               ("--corners", a.corners), ("--feature-angle", a.feature_angle)) if v is not None]
+                               ("--corners", a.corners), ("--feature-angle", a.feature_angle),
+                               ("--feature-sharpness", getattr(a, "feature_sharpness", None))) if v is not None]
     file_tags = mesh.has_tags and not a.ignore_tags
     if scheme == "sqrt3":
         if explicit:
@@ -95,15 +96,20 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     angle = a.feature_angle
     if angle is None and default_angle is not None and not E and not SF and not C:
         angle = default_angle
+    if angle is None and getattr(a, "feature_sharpness", None) is not None:
+        raise CLIError("--feature-sharpness sets the sharpness of detected creases: give --feature-angle too")
     if angle is not None:
         try:
             feat = detect_features(mesh.vertices, mesh.faces, angle)
         except MeshError as err:
             raise CLIError(f"{path}: {err}") from None
+        s_feat = getattr(a, "feature_sharpness", None) or np.inf
         E.append(feat.sharp_edges)
-        S.append(np.full(len(feat.sharp_edges), np.inf))
-        C.append(feat.corners)
-        sources.append(f"dihedral angle > {angle:g}°")
+        S.append(np.full(len(feat.sharp_edges), s_feat))
+        if np.isinf(s_feat):
+            C.append(feat.corners)
+        # semi-sharp: no corner tags, which would pin the vertices while their creases round off
+        sources.append(f"dihedral angle > {angle:g}°" + ("" if np.isinf(s_feat) else f", sharpness {s_feat:g}"))
     if not sources:
         if n_boundary:
             what = f"boundary only ({_n(n_boundary, 'boundary edge')} kept as creases)"
@@ -464,6 +470,16 @@ def _angle(text: str) -> float:
     return x
 
 
+def _sharpness(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number (inf: infinitely sharp), got {text!r}") from None
+    if not x > 0:
+        raise argparse.ArgumentTypeError(f"must be greater than 0, got {x:g}")
+    return np.inf if x >= 10 else x
+
+
 def _tag_options(p, *, scheme=True, input_opts=True) -> None:
     if scheme:
         p.add_argument("--scheme", choices=SCHEMES, default="hybrid",
@@ -471,6 +487,9 @@ def _tag_options(p, *, scheme=True, input_opts=True) -> None:
     g = p.add_argument_group("features (merged when several are given)")
     g.add_argument("--feature-angle", type=_angle, metavar="DEG",
                    help="tag edges whose dihedral angle exceeds DEG degrees as creases")
+    g.add_argument("--feature-sharpness", type=_sharpness, metavar="S",
+                   help="sharpness of the creases --feature-angle finds (default: inf, sharp for ever; "
+                        "S > 0: semi-sharp, sharp for S levels, then rounding off; no corner tags)")
     g.add_argument("--sharp-edges", metavar="FILE", help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
     g.add_argument("--sharp-faces", metavar="FILE", help="faces split by Loop's rule: face indices, 0-based")
     g.add_argument("--corners", metavar="FILE", help="corner vertices: vertex indices, 0-based")

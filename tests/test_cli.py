@@ -194,11 +194,40 @@ def test_tag_files(tmp_path, capsys):
     capsys.readouterr()
 
 
+def test_feature_sharpness_makes_detected_creases_semi_sharp(tmp_path, capsys):
+    """--feature-sharpness 1.5: the detected creases get s = 1.5 and no corner tags; after one
+    level the file holds their children with s = 0.5, after two none are left."""
+    V, F = load_mesh("cube-meshed")
+    feat = hybridsub.detect_features(V, F, 30)
+    s = np.full(len(feat.sharp_edges), 1.5)
+    for levels in (1, 2):
+        out = tmp_path / f"s{levels}.obj"
+        assert main(["subdivide", off("cube-meshed"), "-o", str(out), "--levels", str(levels),
+                     "--feature-angle", "30", "--feature-sharpness", "1.5"]) == 0
+        assert "features: 192 creases (192 semi-sharp), 0 corners — from dihedral angle > 30°, sharpness 1.5" in \
+            capsys.readouterr().err
+        ref = hybridsub.refine(F, feat.sharp_edges, levels, n_vertices=len(V), sharpness=s)
+        m = read_mesh(out)
+        assert np.array_equal(m.faces, ref.faces) and np.allclose(m.vertices, ref.apply(V), atol=1e-15, rtol=0)
+        assert np.array_equal(m.sharp_edges, ref.sharp_edges) and np.array_equal(m.sharpness, ref.sharpness)
+        assert m.sharpness.tolist() == ([0.5] * 384 if levels == 1 else []) and len(m.corners) == 0
+    # 10 or more is infinite: the same as no --feature-sharpness
+    assert main(["subdivide", off("cube-meshed"), "-o", str(tmp_path / "i.obj"), "--levels", "1",
+                 "--feature-angle", "30", "--feature-sharpness", "10", "-q"]) == 0
+    ref = hybridsub.refine(F, feat.sharp_edges, 1, n_vertices=len(V), corners=feat.corners)
+    assert np.array_equal(read_mesh(tmp_path / "i.obj").corners, ref.corners)
+
+
 @pytest.mark.parametrize("args,needle", [
+    (["--feature-sharpness", "2"], "--feature-sharpness sets the sharpness of detected creases: give "
+                                   "--feature-angle too"),
+    (["--scheme", "sqrt3", "--feature-sharpness", "2"], "--feature-sharpness needs --scheme hybrid or loop"),
     (["--sharp-edges", "E"], "e.txt: edge 0 = (0, 5) is not an edge of"),  # opposite corners of the octahedron
     (["--corners", "C"], "c.txt: vertex 99 does not exist"),
     (["--scheme", "sqrt3", "--feature-angle", "30"], "--feature-angle needs --scheme hybrid or loop"),
     (["--feature-angle", "200"], None),
+    (["--feature-sharpness", "0"], None),
+    (["--feature-sharpness", "x"], None),
 ])
 def test_option_errors(tmp_path, capsys, args, needle):
     _write(tmp_path / "e.txt", "0 5\n")
@@ -207,7 +236,9 @@ def test_option_errors(tmp_path, capsys, args, needle):
     if needle is None:  # argparse: exit code 2
         with pytest.raises(SystemExit) as e:
             main(["subdivide", off("octahedron"), "-o", str(tmp_path / "x.obj"), *args])
-        assert e.value.code == 2 and "between 0 and 180" in capsys.readouterr().err
+        expected = {"200": "must be between 0 and 180 degrees, got 200", "0": "must be greater than 0, got 0",
+                    "x": "must be a number (inf: infinitely sharp), got 'x'"}[args[-1]]
+        assert e.value.code == 2 and expected in capsys.readouterr().err
         return
     assert main(["subdivide", off("octahedron"), "-o", str(tmp_path / "x.obj"), *args]) == 1
     err = capsys.readouterr().err.strip().splitlines()
