@@ -848,6 +848,11 @@ def read_edge_file(path: str) -> tuple[np.ndarray, np.ndarray]:
     s = np.array([r[2] if len(r) > 2 else np.inf for r in rows], dtype=np.float64)
     if (E != np.round(E)).any():
         raise MeshError(f"{path}: vertex indices must be integers")
+    bad = np.isnan(s) | (s < 0)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"{path}: edge {j} = ({int(E[j, 0])}, {int(E[j, 1])}) has sharpness {s[j]:g}; give 0 for "
+                        "no crease, > 0 for a crease (>= 10 or inf: infinitely sharp)")
     s = np.where(s >= INFINITE, np.inf, s)
     return E.astype(np.int64), s
 

@@ -157,7 +157,7 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
         See ``docs/scheme.md``.
     sharpness : (k,) array_like of float, optional
         Sharpness of each crease (default ``inf``; finite values are semi-sharp, ``>= 10`` is
-        infinite, ``<= 0`` no crease).
+        infinite, ``0`` no crease; negative or NaN is an error).
     sharp_faces : (m,) bool mask or array_like of int, optional
         Faces refined by Loop's 1-to-4 split (``"hybrid"``).
     corners : array_like of int, optional
@@ -287,7 +287,8 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
         ``"hybrid"``: √3 on smooth faces, Loop on sharp faces, creases split and never flipped;
         ``"sqrt3"``: Kobbelt's √3 with his boundary rule, no tags; ``"loop"``: Loop with creases.
     sharpness : (k,) array_like of float, optional
-        Sharpness per crease (semi-sharp creases); default infinitely sharp.
+        Sharpness per crease: ``inf`` (default) or ``>= 10`` infinitely sharp, ``0 < s < 10``
+        semi-sharp (``docs/semisharp.md``), ``0`` no crease; negative or NaN is an error.
     sharp_faces : (m,) bool mask or array_like of int, optional
         Faces split 1-to-4 by Loop's rule.
     corners : array_like of int, optional

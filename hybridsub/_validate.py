@@ -207,7 +207,13 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
             j = int(np.flatnonzero(np.isnan(s))[0])
             raise MeshError(
                 f"sharpness {j} (of sharp edge {E[j].tolist()}) is NaN; give a number: > 0 for a crease "
-                "(>= 10 or inf: infinitely sharp), <= 0 for none"
+                "(>= 10 or inf: infinitely sharp), 0 for none"
+            )
+        if (s < 0).any():
+            j = int(np.flatnonzero(s < 0)[0])
+            raise MeshError(
+                f"sharpness {j} (of sharp edge {E[j].tolist()}) is negative ({s[j]:g}); give 0 for no crease, "
+                "> 0 for a crease (>= 10 or inf: infinitely sharp)"
             )
         s = R.normalize_sharpness(s)
     return E, s

@@ -487,7 +487,7 @@ def meshes(kind="any", *, bowties=True, shuffle=True, max_points=100):
 def random_sharpness(rng, k, kind="mixed"):
     """``kind``: "inf" (all inf), "mixed" (inf, (0,1), (1,3), >= 10, and exact 1 and 2),
     "finite" (no inf, no >= 10), "semisharp" ((0, 1) and (1, 3) only), "mixed0" (as
-    "mixed", plus 0 and negative values, which mean "no crease")."""
+    "mixed", plus 0 and -0.0, which mean "no crease"; negative values are an error)."""
     if kind == "inf":
         return np.full(k, np.inf)
     if kind == "mixed":
@@ -508,7 +508,7 @@ def random_sharpness(rng, k, kind="mixed"):
     s[cat == 4] = 1.0
     s[cat == 5] = 2.0
     s[cat == 6] = 0.0
-    s[cat == 7] = -rng.uniform(0.1, 2.0, size=(cat == 7).sum())
+    s[cat == 7] = -0.0
     return s
 
 

@@ -222,7 +222,8 @@ def test_feature_sharpness_makes_detected_creases_semi_sharp(tmp_path, capsys):
     (["--feature-sharpness", "2"], "--feature-sharpness sets the sharpness of detected creases: give "
                                    "--feature-angle too"),
     (["--scheme", "sqrt3", "--feature-sharpness", "2"], "--feature-sharpness needs --scheme hybrid or loop"),
-    (["--sharp-edges", "E"], "e.txt: edge 0 = (0, 5) is not an edge of"),  # opposite corners of the octahedron
+    (["--sharp-edges", "E"], "e.txt: edge 0 = (0, 5) is not an edge of"),
+    (["--sharp-edges", "N"], "n.txt: edge 1 = (0, 2) has sharpness -1; give 0 for no crease"),  # opposite corners of the octahedron
     (["--corners", "C"], "c.txt: vertex 99 does not exist"),
     (["--scheme", "sqrt3", "--feature-angle", "30"], "--feature-angle needs --scheme hybrid or loop"),
     (["--feature-angle", "200"], None),
@@ -232,7 +233,9 @@ def test_feature_sharpness_makes_detected_creases_semi_sharp(tmp_path, capsys):
 def test_option_errors(tmp_path, capsys, args, needle):
     _write(tmp_path / "e.txt", "0 5\n")
     _write(tmp_path / "c.txt", "99\n")
-    args = [str(tmp_path / "e.txt") if a == "E" else str(tmp_path / "c.txt") if a == "C" else a for a in args]
+    _write(tmp_path / "n.txt", "0 1 2\n0 2 -1\n")
+    files = {"E": "e.txt", "C": "c.txt", "N": "n.txt"}
+    args = [str(tmp_path / files[a]) if a in files else a for a in args]
     if needle is None:  # argparse: exit code 2
         with pytest.raises(SystemExit) as e:
             main(["subdivide", off("octahedron"), "-o", str(tmp_path / "x.obj"), *args])
