@@ -345,10 +345,14 @@ def test_errors():
         hybridsub.subdivide_face_varying(V, F, UV, FUV, uv_mode="cubic")
     with pytest.raises(hybridsub.MeshError, match="FUV must have shape"):
         hybridsub.subdivide_face_varying(V, F, UV, FUV[:1])
-    with pytest.raises(hybridsub.MeshError, match="only 5 UV values"):
+    with pytest.raises(hybridsub.MeshError, match=r"FUV: face 1 has UV indices \[3, 4, 5\], but there are only 5"):
         hybridsub.subdivide_face_varying(V, F, UV[:5], FUV)
-    with pytest.raises(TypeError, match="FUV must hold integer"):
+    with pytest.raises(hybridsub.MeshError, match="FUV must hold integer UV indices; face 0"):
         hybridsub.subdivide_face_varying(V, F, UV, FUV + 0.5)
+    with pytest.raises(TypeError, match="FUV must hold integer"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV > 2)
+    with pytest.raises(hybridsub.MeshError, match="FUV: face 1 has a negative UV index"):
+        hybridsub.subdivide_face_varying(V, F, UV, FUV - [[0, 0, 0], [4, 0, 0]])
     with pytest.raises(hybridsub.MeshError, match="not an edge"):
         hybridsub.subdivide_face_varying(V, F, UV, FUV, [[1, 3]])
 
@@ -361,3 +365,94 @@ def test_topology_errors_are_named_as_in_subdivide():
         hybridsub.subdivide(V, F)
     with pytest.raises(hybridsub.MeshError, match="duplicate"):
         hybridsub.subdivide_face_varying(V, F, np.zeros((3, 2)), F)
+
+
+# --------------------------------------------------------------------------- refine(uv_faces=)
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+@pytest.mark.parametrize("uv_mode", ["linear", "smooth"])
+def test_refine_with_uv_faces_is_refine_face_varying(icosa_uv, scheme, uv_mode):
+    """refine(uv_faces=) is refine_face_varying's geometry, UV faces and matrices attached; the
+    fast path (subdivide_face_varying) gives the bits of its step matrices applied in turn."""
+    V, F, UV, FUV, cuts = icosa_uv
+    creases = np.array(cuts[:2])
+    kw = dict(scheme=scheme, uv_mode=uv_mode, sharpness=[np.inf, 1.5], corners=[int(F[7, 0])])
+    FUV_in = FUV.copy()
+    r = hybridsub.refine(F, creases, 3, uv_faces=FUV, **kw)
+    assert np.array_equal(FUV, FUV_in)  # the caller's array is not touched
+    geo, uv = hybridsub.refine_face_varying(F, FUV, creases, 3, **kw)
+    assert np.array_equal(r.faces, geo.faces) and np.array_equal(r.uv_faces, uv.faces)
+    assert np.array_equal(r.apply(V), geo.apply(V))  # the same positions, bit for bit
+    assert (r.uv_matrix != uv.matrix).nnz == 0 and r.uv_matrix.shape == (uv.n_vertices, len(UV))
+    assert geo.uv_faces is uv.faces and (geo.uv_matrix != uv.matrix).nnz == 0
+    for st, ust in zip(r.steps, uv.steps):
+        assert np.array_equal(st.uv_faces, ust.faces) and (st.uv_matrix != ust.matrix).nnz == 0
+        assert st.uv_faces.shape == st.faces.shape
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, creases, 3, **kw)
+    U = UV
+    for st in r.steps:
+        U = st.uv_matrix @ U
+    assert np.array_equal(V2, r.apply(V)) and np.array_equal(UV2, U)
+    assert np.array_equal(F2, r.faces) and np.array_equal(FUV2, r.uv_faces)
+    assert np.allclose(r.uv_matrix @ UV, UV2, atol=TOL, rtol=0)
+    # seams are split, so the hybrid's geometry is not the one without UVs: one more vertex per seam
+    plain = hybridsub.refine(F, creases, 1, scheme=scheme, sharpness=[np.inf, 1.5])
+    with_uv = hybridsub.refine(F, creases, 1, uv_faces=FUV, scheme=scheme, sharpness=[np.inf, 1.5])
+    seams = {frozenset(e) for e in hybridsub.seam_edges(F, FUV).tolist()}
+    extra = len(seams - {frozenset(e) for e in creases.tolist()}) if scheme == "hybrid" else 0
+    assert extra == (2 if scheme == "hybrid" else 0)  # four seams, two of them creases (split anyway)
+    assert with_uv.n_vertices == plain.n_vertices + extra
+    assert plain.uv_faces is None and plain.uv_matrix is None and plain.steps[0].uv_matrix is None
+
+
+def test_refine_with_uv_faces_levels_zero_and_no_faces():
+    r = hybridsub.refine(SQUARE_F, levels=0, uv_faces=SQUARE_FUV)
+    assert np.array_equal(r.uv_faces, SQUARE_FUV) and r.uv_faces is not SQUARE_FUV
+    assert np.array_equal(r.uv_matrix.toarray(), np.eye(6))
+    e = hybridsub.refine(np.empty((0, 3), int), levels=2, n_vertices=3, uv_faces=np.empty((0, 3), int), n_uvs=4)
+    assert e.uv_faces.shape == (0, 3) and e.uv_matrix.shape == (4, 4) and len(e.steps) == 2
+    assert e.steps[1].uv_matrix.shape == (4, 4)
+
+
+def test_refine_with_uv_faces_cuts_non_manifold_edges():
+    """non_manifold="cut" keeps the faces and their order, so the UV index mesh rides along."""
+    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]])  # edge 0-1 in three faces
+    FUV = np.array([[0, 1, 2], [3, 4, 5], [6, 7, 8], [2, 1, 9]])  # faces 0 and 3 share a chart
+    with pytest.raises(hybridsub.MeshError, match="3 faces"):
+        hybridsub.refine(F, uv_faces=FUV)
+    r = hybridsub.refine(F, levels=2, scheme="loop", uv_faces=FUV, non_manifold="cut")
+    plain = hybridsub.refine(F, levels=2, scheme="loop", non_manifold="cut")
+    assert np.array_equal(r.faces, plain.faces) and (r.matrix != plain.matrix).nnz == 0
+    assert r.uv_faces.shape == r.faces.shape and r.uv_matrix.shape[1] == 10
+    # linear UVs of a Loop refinement: each corner a convex combination of its parent's UVs
+    M = r.uv_matrix.tocsr()
+    for f2, p in enumerate(r.face_parent):
+        for u in r.uv_faces[f2]:
+            row = M.getrow(u)
+            assert set(row.indices) <= set(FUV[p].tolist()) and row.data.min() > 0
+            assert abs(row.data.sum() - 1) < TOL
+
+
+def test_refine_with_uv_faces_errors():
+    F, FUV = SQUARE_F, SQUARE_FUV
+    with pytest.raises(ValueError, match='"hybrid"'):
+        hybridsub.refine(F, uv_faces=FUV, scheme="sqrt3")
+    with pytest.raises(ValueError, match="uv_mode must be one of"):
+        hybridsub.refine(F, uv_faces=FUV, uv_mode="cubic")
+    with pytest.raises(ValueError, match="uv_mode must be one of"):
+        hybridsub.refine(F, uv_mode="cubic")
+    with pytest.raises(ValueError, match="n_uvs was given without uv_faces"):
+        hybridsub.refine(F, n_uvs=6)
+    with pytest.raises(hybridsub.MeshError, match=r"uv_faces must have shape \(2, 3\)"):
+        hybridsub.refine(F, uv_faces=FUV[:, :2])
+    with pytest.raises(hybridsub.MeshError, match=r"uv_faces: face 1 has UV indices \[3, 4, 5\], but there are only 4"):
+        hybridsub.refine(F, uv_faces=FUV, n_uvs=4)
+    with pytest.raises(hybridsub.MeshError, match="uv_faces: face 0 has a negative"):
+        hybridsub.refine(F, uv_faces=-FUV)
+    with pytest.raises(hybridsub.MeshError, match="uv_faces must hold integer UV indices; face 1"):
+        hybridsub.refine(F, uv_faces=FUV * [[1.0], [0.5]])
+    with pytest.raises(TypeError, match="uv_faces must hold integer"):
+        hybridsub.refine(F, uv_faces=FUV.astype(str))
+    with pytest.raises(ValueError, match="n_uvs must be a non-negative integer"):
+        hybridsub.refine(F, uv_faces=FUV, n_uvs=-1)
+    with pytest.raises(hybridsub.OutputTooLargeError):
+        hybridsub.refine(F, levels=8, uv_faces=FUV, max_memory=10_000)
