@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from . import _validate as val
+from ._io import classes
 from ._errors import MeshError
 from ._features import detect_features
 from ._refine import Refinement, refine
@@ -209,28 +210,9 @@ class _Weld(NamedTuple):
         return _Weld(V, F, idx, idx, None, None, frozenset(), False, False)
 
 
-def _labels(arrays: list, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Classes of rows equal in every array, numbered by first appearance: (class of each row,
-    first row of each class)."""
-    lab = np.zeros(n, np.int64)
-    for A in arrays:
-        A = np.ascontiguousarray(A).reshape(n, -1)
-        if A.dtype.kind == "f":
-            A = A + 0.0  # -0.0 and 0.0 are one position
-        _, inv = np.unique(A, axis=0, return_inverse=True)
-        key = lab * (int(inv.max(initial=0)) + 1) + inv.ravel()
-        _, lab = np.unique(key, return_inverse=True)
-        lab = lab.ravel()
-    _, first, inv = np.unique(lab, return_index=True, return_inverse=True)
-    order = np.argsort(first, kind="stable")
-    rank = np.empty(len(order), np.int64)
-    rank[order] = np.arange(len(order))
-    return rank[inv.ravel()], first[order]
-
-
 def _weld(V, F, uv, data: dict) -> _Weld:
     n = len(V)
-    geo, geo_first = _labels([V], n)
+    geo, geo_first = classes([V], n)
     Fg = geo[F]
     degenerate = (Fg[:, 0] == Fg[:, 1]) | (Fg[:, 1] == Fg[:, 2]) | (Fg[:, 2] == Fg[:, 0])
     if degenerate.any():
@@ -241,7 +223,7 @@ def _weld(V, F, uv, data: dict) -> _Weld:
                         "weld=False")
     varying = frozenset(k for k, A in data.items() if not _same_on_copies(A, geo, geo_first))
     keys = [geo] + ([uv] if uv is not None else []) + [data[k] for k in sorted(varying)]
-    corner, corner_first = _labels(keys, n)
+    corner, corner_first = classes(keys, n)
     return _Weld(np.ascontiguousarray(V[geo_first]), np.ascontiguousarray(Fg), geo, geo_first,
                  np.ascontiguousarray(corner[F]), corner_first, varying, True, uv is not None or bool(varying))
 
