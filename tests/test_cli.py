@@ -372,6 +372,26 @@ def test_renderer_hides_what_is_behind():
     assert red(33, 60)
 
 
+def test_renderer_draws_a_texture_from_face_varying_uvs():
+    """A square facing the camera, two triangles with their own UV indices (a seam on the
+    diagonal, the UVs continuous across it): a 2 × 2 checkerboard lands in the four quarters."""
+    from hybridsub._render import render, view_rotation
+
+    V = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    UV = np.array([[0, 0], [1, 0], [1, 1], [0, 0], [1, 1], [0, 1]], float)
+    FUV = np.array([[0, 1, 2], [3, 4, 5]])
+
+    def image(uv):
+        odd = (np.floor(uv[:, 0] * 2) + np.floor(uv[:, 1] * 2)) % 2 == 1
+        return np.where(odd[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+
+    img = render(V, F, view_rotation(0, 0), 100, 100, outline=False, texture=(UV, FUV, image)).astype(int)
+    blue = lambda y, x: img[y, x, 2] > 2 * img[y, x, 0]  # noqa: E731
+    assert not blue(70, 30) and blue(70, 70) and blue(30, 30) and not blue(30, 70)  # (u, v) = image (x, up)
+    assert (img[2, 2] == 255).all()
+
+
 # ----------------------------------------------------------------------------------------------
 # textured OBJ: vt and f v/vt, seams refined face-varying
 
