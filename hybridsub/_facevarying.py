@@ -385,11 +385,13 @@ def _walk(setup: _Setup, budget=None):
     corner = setup.corner
     level = val.checked_level(setup.F, setup.n, setup.pairs).tag(setup.pairs, setup.sharp, setup.face_sharp)
     uvl = _uv_level(level, setup.T, setup.t)
-    uv_corner = _carried_corners(level, uvl, corner)
-    uv_corners_in = np.flatnonzero(uv_corner | _irregular_uv(level, uvl))
+    # UV corners: carried corner tags and irregular UV indices. Both keep their status from
+    # level to level, and new UV values are neither (each lies on one new vertex, in one sector).
+    uv_fixed = _carried_corners(level, uvl, corner) | _irregular_uv(level, uvl)
+    uv_corners_in = np.flatnonzero(uv_fixed)
     for step in range(1, setup.levels + 1):
-        plan = plan_step(level, corner, scheme, step, loop_weights, force_split=_seam_halfedges(level, uvl.faces))
-        uv_fixed = uv_corner | _irregular_uv(level, uvl)
+        seams = (uvl.twin < 0) & (level.twin >= 0)  # the UV mesh is cut exactly along the seams
+        plan = plan_step(level, corner, scheme, step, loop_weights, force_split=seams)
         uv_plan = plan_step(uvl, uv_fixed, scheme, step, loop_weights, force_split=plan.hkind == R.EDGE_SPLIT)
         if not np.array_equal(uv_plan.hkind, plan.hkind):
             raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
@@ -399,7 +401,7 @@ def _walk(setup: _Setup, budget=None):
         uv_faces, uv_child, _ = child_level(uvl, uv_plan)
         yield _Step(step, level, plan, uvl, uv_plan, faces, uv_faces, child, uv_child, offsets, uv_corners_in)
         corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
-        uv_corner = np.concatenate([uv_corner, np.zeros(uv_plan.n_new - len(uv_corner), dtype=bool)])
+        uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
         level, uvl = child, uv_child
 
 
@@ -461,17 +463,23 @@ def _carried_corners(level: Level, uvl: Level, corner: np.ndarray) -> np.ndarray
 
 
 def _linear_matrix(uvl: Level, plan) -> sp.csr_matrix:
-    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids."""
+    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids.
+
+    Built as CSR directly: the rows are the old values, then the edge points in UV edge
+    order, then the face points in face order (the layout of ``plan``), columns sorted.
+    """
     t = uvl.n_vertices
-    owner = uvl.edge_owner
-    has_point = plan.edge_point[owner] >= 0
-    e = owner[has_point]
-    f = np.flatnonzero(plan.face_point >= 0)
-    rows = np.concatenate([np.arange(t), np.repeat(plan.edge_point[e], 2), np.repeat(plan.face_point[f], 3)])
-    cols = np.concatenate([np.arange(t), uvl.edge_vertices[has_point].ravel(), uvl.faces[f].ravel()])
-    data = np.concatenate([np.ones(t), np.full(2 * len(e), 0.5), np.full(3 * len(f), 1.0 / 3.0)])
-    S = sp.csr_matrix((data, (rows, cols)), shape=(plan.n_new, t))
-    S.sum_duplicates()  # a degenerate UV edge (p, p) gives one entry 1.0
+    has_point = plan.edge_point[uvl.edge_owner] >= 0
+    E = np.sort(uvl.edge_vertices[has_point], axis=1)
+    T = np.sort(uvl.faces[plan.face_point >= 0], axis=1)
+    indptr = np.concatenate([np.arange(t + 1), t + 2 * np.arange(1, len(E) + 1),
+                             t + 2 * len(E) + 3 * np.arange(1, len(T) + 1)])
+    indices = np.concatenate([np.arange(t), E.ravel(), T.ravel()])
+    data = np.concatenate([np.ones(t), np.full(E.size, 0.5), np.full(T.size, 1.0 / 3.0)])
+    S = sp.csr_matrix((data, indices, indptr), shape=(plan.n_new, t))
+    if (E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any():
+        S.sum_duplicates()  # a degenerate UV edge (p, p) gives one entry 1.0
+    S.has_sorted_indices = True
     return S
 
 

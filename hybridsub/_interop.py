@@ -166,10 +166,9 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     except MeshError as e:
         if not w.welded:
             raise
-        k = n - len(w.V)
-        raise MeshError(f"{e} — in the welded mesh ({k} {'vertex' if k == 1 else 'vertices'} at the position of an "
-                        "earlier one merged, vertices numbered by first appearance); pass weld=False to subdivide "
-                        "the mesh as stored") from None
+        merged = _count(n - len(w.V), "vertex", "vertices")
+        raise MeshError(f"{e} — in the welded mesh ({merged} at the position of an earlier one merged, vertices "
+                        "numbered by first appearance); pass weld=False to subdivide the mesh as stored") from None
     parent = r.face_parent
     out = _Output(r, w)
     visual = _refine_visual(mesh, out, parent, uv)
@@ -218,7 +217,7 @@ def _weld(V, F, uv, data: dict) -> _Weld:
     if degenerate.any():
         f = int(np.flatnonzero(degenerate)[0])
         raise MeshError(f"face {f} = {F[f].tolist()} has two corners at the same position (at {V[F[f]].tolist()}), "
-                        f"so it collapses when coincident vertices are welded ({int(degenerate.sum())} such faces); "
+                        f"so it collapses when coincident vertices are welded ({_count(degenerate.sum(), 'such face')}); "
                         "remove such faces (trimesh: mesh.update_faces(mesh.nondegenerate_faces())), or pass "
                         "weld=False")
     varying = frozenset(k for k, A in data.items() if not _same_on_copies(A, geo, geo_first))
@@ -285,6 +284,11 @@ class _Output:
         h = order[np.searchsorted(key[order], want)]
         tu, tw = T.ravel(), np.roll(T, -1, axis=1).ravel()
         return np.stack([tu[h], tw[h]], axis=1), sharp
+
+
+def _count(k, noun: str, plural: str | None = None) -> str:
+    k = int(k)
+    return f"{k} {noun if k == 1 else plural or noun + 's'}"
 
 
 def _vertex_uv(mesh) -> np.ndarray | None:
