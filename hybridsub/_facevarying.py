@@ -223,7 +223,7 @@ def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_e
         if uv_mode == "smooth":
             UV = apply_step(s.uvl, s.uv_plan, UV)
         else:
-            UV = apply_matrix(_linear_matrix(s.uvl, s.uv_plan), UV)
+            UV = _linear_apply(s.uvl, s.uv_plan, UV)
         pairs, sharp = child_creases(s.level, s.plan)
         yield FaceVaryingLevel(s.step, X, s.faces, UV, s.uv_faces, face_parents(s.offsets), pairs, sharp,
                                s.child.face_sharp)
@@ -462,25 +462,51 @@ def _carried_corners(level: Level, uvl: Level, corner: np.ndarray) -> np.ndarray
     return out
 
 
-def _linear_matrix(uvl: Level, plan) -> sp.csr_matrix:
-    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids.
-
-    Built as CSR directly: the rows are the old values, then the edge points in UV edge
-    order, then the face points in face order (the layout of ``plan``), columns sorted.
-    """
+def _linear_rows(uvl: Level, plan) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The UV edges (k, 2) and UV faces (l, 3) of ``uv_mode="linear"``'s new values, in
+    ``plan``'s layout (old values, then edge points, then face points), each row sorted; and
+    whether one repeats a UV index (a degenerate UV edge or face)."""
     t = uvl.n_vertices
-    has_point = plan.edge_point[uvl.edge_owner] >= 0
-    E = np.sort(uvl.edge_vertices[has_point], axis=1)
-    T = np.sort(uvl.faces[plan.face_point >= 0], axis=1)
+    h = np.flatnonzero(plan.edge_point >= 0)
+    h = h[(uvl.twin[h] < 0) | (h < uvl.twin[h])]  # one halfedge per split edge
+    fv = uvl.faces.ravel()
+    E = np.empty((len(h), 2), np.int64)
+    E[plan.edge_point[h] - t] = np.sort(np.stack([fv[h], fv[h - h % 3 + (h % 3 + 1) % 3]], axis=1), axis=1)
+    f = np.flatnonzero(plan.face_point >= 0)
+    T = np.empty((len(f), 3), np.int64)
+    T[plan.face_point[f] - t - len(h)] = np.sort(uvl.faces[f], axis=1)
+    return E, T, bool((E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any())
+
+
+def _linear_matrix(uvl: Level, plan) -> sp.csr_matrix:
+    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids (CSR, built
+    directly, columns sorted)."""
+    t = uvl.n_vertices
+    E, T, degenerate = _linear_rows(uvl, plan)
     indptr = np.concatenate([np.arange(t + 1), t + 2 * np.arange(1, len(E) + 1),
                              t + 2 * len(E) + 3 * np.arange(1, len(T) + 1)])
     indices = np.concatenate([np.arange(t), E.ravel(), T.ravel()])
     data = np.concatenate([np.ones(t), np.full(E.size, 0.5), np.full(T.size, 1.0 / 3.0)])
     S = sp.csr_matrix((data, indices, indptr), shape=(plan.n_new, t))
-    if (E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any():
+    if degenerate:
         S.sum_duplicates()  # a degenerate UV edge (p, p) gives one entry 1.0
     S.has_sorted_indices = True
     return S
+
+
+def _linear_apply(uvl: Level, plan, UV: np.ndarray) -> np.ndarray:
+    """``_linear_matrix(uvl, plan) @ UV`` without forming it: the same sums in the same order,
+    so the same bits (a degenerate UV edge or face goes through the matrix, whose merged
+    entries sum differently)."""
+    E, T, degenerate = _linear_rows(uvl, plan)
+    if degenerate:
+        return apply_matrix(_linear_matrix(uvl, plan), UV)
+    t, w = uvl.n_vertices, 1.0 / 3.0
+    out = np.empty((plan.n_new, UV.shape[1]))
+    out[:t] = UV
+    out[t:t + len(E)] = 0.5 * UV[E[:, 0]] + 0.5 * UV[E[:, 1]]
+    out[t + len(E):] = w * UV[T[:, 0]] + w * UV[T[:, 1]] + w * UV[T[:, 2]]
+    return out
 
 
 # ---------------------------------------------------------------------------------------

@@ -631,10 +631,12 @@ def sectors(F, cut):
 
 
 @st.composite
-def uv_charts(draw, F, *, max_fraction=0.6):
+def uv_charts(draw, F, *, max_fraction=0.6, unmapped=None):
     """Random UV charts on a mesh ``F``: ``(UV (t, 2), FUV (m, 3))``, one UV index per
     (vertex, face sector), sectors cut along a random subset of the interior edges (the
-    seams), UV indices in random order, a few unused UV values, random UV values."""
+    seams), UV indices in random order, a few unused UV values, random UV values. With
+    ``unmapped`` (drawn if None) a few faces have all three corners on one extra UV index, as
+    files map untextured faces (degenerate UV faces, a UV index on several vertices)."""
     F = np.asarray(F, dtype=np.int64)
     rng = draw(rngs())
     twin = twins_of(F)
@@ -648,7 +650,12 @@ def uv_charts(draw, F, *, max_fraction=0.6):
     t = int(label.max()) + 1 if len(label) else 0
     extra = draw(st.integers(0, 2))
     perm = rng.permutation(t + extra)[:t]
-    return rng.random((t + extra, 2)), perm[label.ravel()].reshape(-1, 3).astype(np.int64)
+    FUV = perm[label.ravel()].reshape(-1, 3).astype(np.int64)
+    unmapped = draw(st.booleans()) if unmapped is None else unmapped
+    if unmapped and len(F) >= 2:
+        FUV[rng.choice(len(F), size=rng.integers(1, len(F) // 4 + 2), replace=False)] = t + extra
+        extra += 1
+    return rng.random((t + extra, 2)), FUV
 
 
 # ------------------------------- broken meshes ------------------------------------------

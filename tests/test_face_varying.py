@@ -344,6 +344,8 @@ def test_uv_index_on_several_vertices_and_degenerate_uv_face():
     for uv_mode in ("linear", "smooth"):
         V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, uv_mode=uv_mode)
         assert np.array_equal(UV2[0], UV[0]) and np.isfinite(UV2).all()
+        r = hybridsub.refine(F, levels=2, uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode)  # the fast path's bits
+        assert np.array_equal(UV2, r.steps[1].uv_matrix @ (r.steps[0].uv_matrix @ UV))
         kids = hybridsub.refine_face_varying(F, FUV, levels=2).uv.face_parent == 2
         assert np.allclose(UV2[FUV2[kids]], UV[0], atol=TOL, rtol=0)  # the whole face stays on it
 
@@ -614,12 +616,24 @@ def test_random_charts_stay_aligned_and_seams_are_never_flipped(data, scheme, uv
                          uv_mode=uv_mode, **tags)
     G, T, P = r.faces, r.uv_faces, r.face_parent
     assert G.shape == T.shape and r.uv_matrix.shape == (r._uv.n_vertices, len(UV))
+    # the fast path (no matrices) gives the bits of the step matrices applied in turn
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=L, scheme=scheme, uv_mode=uv_mode,
+                                                         **tags)
+    U = UV
+    for st_ in r.steps:
+        U = st_.uv_matrix @ U
+    assert np.array_equal(F2, G) and np.array_equal(FUV2, T) and np.array_equal(UV2, U)
+    assert np.array_equal(V2, r.apply(V))
     old = G < len(V)
     hit = F[P][:, None, :] == G[:, :, None]  # (m', 3, 3): output corner k is parent corner j
     assert (hit.sum(axis=2) == old).all()  # an old vertex is a corner of its parent face
     assert np.array_equal(np.einsum("fkj,fj->fk", hit, FUV[P])[old], T[old])  # with the parent's UV index
-    pairs = np.unique(np.stack([T.ravel(), G.ravel()], 1), axis=0)
-    assert len(np.unique(pairs[:, 0])) == len(pairs)  # one vertex per UV index
+    def shared(T, G):  # UV indices on several vertices (a face mapped to one UV point)
+        pairs = np.unique(np.stack([T.ravel(), G.ravel()], 1), axis=0)
+        u, c = np.unique(pairs[:, 0], return_counts=True)
+        return set(u[c > 1].tolist())
+
+    assert shared(T, G) == shared(FUV, F)  # else one vertex per UV index, as in the input
     # seams: the children of seams, 2^L per seam, and nothing else
     sides_in = _seam_sides(F, FUV)
     sides_out = _seam_sides(G, T)
@@ -653,12 +667,15 @@ def test_random_charts_linear_uvs_stay_on_what_they_refine(data, scheme):
         faces = {frozenset(f) for f in T.tolist()}
         for u in range(len(U), len(U2)):
             cols = M.indices[M.indptr[u]:M.indptr[u + 1]]
-            if len(cols) == 2:
-                assert frozenset(cols.tolist()) in edges
-                assert np.allclose(U2[u], U[cols].mean(axis=0), atol=1e-15, rtol=0)
-            else:
-                assert len(cols) == 3 and frozenset(cols.tolist()) in faces
-                assert np.allclose(U2[u], U[cols].mean(axis=0), atol=1e-15, rtol=0)
+            w = np.sort(M.data[M.indptr[u]:M.indptr[u + 1]])
+            # a midpoint of a UV edge or the centroid of a UV face (on a degenerate UV edge
+            # or face, the weights of a repeated UV index add up: 1, or 2/3 and 1/3)
+            assert len(w) in (1, 2, 3) and np.allclose(w, {1: [1], 2: [w[0], 1 - w[0]], 3: [1 / 3] * 3}[len(w)],
+                                                       atol=1e-15, rtol=0)
+            assert len(w) != 2 or np.isclose(w[0], 0.5, atol=1e-15, rtol=0) or np.isclose(w[0], 1 / 3, atol=1e-15,
+                                                                                          rtol=0)
+            assert len(w) == 1 or frozenset(cols.tolist()) in (faces if len(w) == 3 else edges)
+            assert np.allclose(U2[u], M.data[M.indptr[u]:M.indptr[u + 1]] @ U[cols], atol=1e-15, rtol=0)
         U, T = U2, st_.uv_faces
     if scheme == "loop":  # no flips: every child lies in its input face, in UV too
         tri = UV[FUV[r.face_parent]]  # (m', 3, 2)
