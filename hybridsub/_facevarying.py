@@ -147,6 +147,7 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     geo = refine(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                  sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                  max_memory=max_memory, uv_faces=FUV, n_uvs=n_uvs, uv_mode=uv_mode)
+    assert geo._uv is not None  # refine attaches it whenever uv_faces is given
     return FaceVaryingRefinement(geo, geo._uv)
 
 
@@ -164,12 +165,12 @@ def refine_with_uvs(F, FUV, sharp_edges, levels, *, n_vertices, n_uvs, scheme, u
     geo_steps, uv_steps = [], []
     face_parent = np.arange(len(Fi), dtype=np.int64)
     uv_pairs, uv_sharp = np.empty((0, 2), np.int64), np.empty(0)
-    uv_corners_out = None
-    level = uvl = None
+    uv_corners_out = np.empty(0, np.int64)
+    level: Level | None = None
+    uvl: Level | None = None
     for s in _walk(setup, budget):
         level, uvl = s.child, s.uv_child
-        if uv_corners_out is None:
-            uv_corners_out = s.uv_corners_in
+        uv_corners_out = s.uv_corners_in
         S = step_matrix(s.level, s.plan)
         S_uv = step_matrix(s.uvl, s.uv_plan) if uv_mode == "smooth" else _linear_matrix(s.uvl, s.uv_plan)
         pairs, sharp = child_creases(s.level, s.plan)
@@ -179,7 +180,7 @@ def refine_with_uvs(F, FUV, sharp_edges, levels, *, n_vertices, n_uvs, scheme, u
         mask = faces_out(level.face_sharp)
         geo_steps.append(RefinementStep(s.faces, S, pairs, sharp, mask, corners_out, parent, s.uv_faces, S_uv))
         uv_steps.append(RefinementStep(s.uv_faces, S_uv, uv_pairs, uv_sharp, mask, uv_corners_out, parent))
-    if level is None:  # levels == 0: the input, checked
+    if level is None or uvl is None:  # levels == 0: the input, checked
         level = val.checked_level(Fi, n, pairs)
         uv_corners_out = _uv_corners(level.tag(pairs, sharp, setup.face_sharp), T, t, setup.corner)
         geo_faces, uv_faces, sharp_mask = Fi.copy(), T.copy(), faces_out(setup.face_sharp)

@@ -134,10 +134,13 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
             "as stored (its seams open, as boundaries)")
 
     # tags, in the welded vertex numbers
+    edges_w: np.ndarray | None = None
+    sharp_w: np.ndarray | None = None
+    corners_w: np.ndarray | None = None
     if sharp_edges is not None:
-        pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
-        sharp_edges, sharpness = w.geo[pairs], sharp
-        same = sharp_edges[:, 0] == sharp_edges[:, 1]
+        pairs, sharp_w = val.as_sharp_edges(sharp_edges, sharpness, n)
+        edges_w = w.geo[pairs]
+        same = edges_w[:, 0] == edges_w[:, 1]
         if same.any():
             i = int(np.flatnonzero(same)[0])
             raise MeshError(f"sharp edge {i} = {pairs[i].tolist()} joins two vertices at the same position, which "
@@ -145,24 +148,21 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     elif sharpness is not None and np.size(sharpness):
         raise ValueError("sharpness was given without sharp_edges")
     if corners is not None:
-        corners = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
+        corners_w = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
     if feature_angle is not None:
         feat = detect_features(w.V, w.F, feature_angle)
-        if sharp_edges is None:
-            sharp_edges, sharpness = feat.sharp_edges, None
+        if edges_w is None or sharp_w is None:
+            edges_w, sharp_w = feat.sharp_edges, None
         else:
-            s = np.asarray(sharpness, dtype=np.float64)
-            sharp_edges = np.vstack([sharp_edges, feat.sharp_edges])
-            sharpness = np.concatenate([s, np.full(len(feat.sharp_edges), np.inf)])
-        corners = feat.corners if corners is None else np.union1d(corners, feat.corners)
+            edges_w = np.vstack([edges_w, feat.sharp_edges])
+            sharp_w = np.concatenate([sharp_w, np.full(len(feat.sharp_edges), np.inf)])
+        corners_w = feat.corners if corners_w is None else np.union1d(corners_w, feat.corners)
 
-    kw = dict(scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
     try:
-        if w.face_varying:
-            r = refine(w.F, sharp_edges, levels, n_vertices=len(w.V), uv_faces=w.FUV, n_uvs=len(w.corner_first),
-                       uv_mode=uv_mode, **kw)
-        else:
-            r = refine(w.F, sharp_edges, levels, n_vertices=len(w.V), **kw)
+        r = refine(w.F, edges_w, levels, n_vertices=len(w.V), scheme=scheme, sharpness=sharp_w,
+                   sharp_faces=sharp_faces, corners=corners_w, loop_weights=loop_weights,
+                   uv_faces=w.FUV if w.face_varying else None, uv_mode=uv_mode,
+                   n_uvs=w.n_corners if w.face_varying else None)
     except MeshError as e:
         if not w.welded:
             raise
@@ -203,6 +203,10 @@ class _Weld(NamedTuple):
     welded: bool
     face_varying: bool  # refine face-varying (UVs, or arrays that differ between copies)
 
+    @property
+    def n_corners(self) -> int:
+        return 0 if self.corner_first is None else len(self.corner_first)
+
     @staticmethod
     def identity(V, F) -> _Weld:
         idx = np.arange(len(V), dtype=np.int64)
@@ -237,15 +241,16 @@ class _Output:
 
     def __init__(self, r: Refinement, w: _Weld):
         self.r, self.w = r, w
-        if w.face_varying:
+        self.faces: np.ndarray = r.faces
+        self.geo_of: np.ndarray | None = None  # welded fine vertex of each output vertex
+        self.uv_r: Refinement | None = r._uv
+        self.corner_first = np.empty(0, np.int64) if w.corner_first is None else w.corner_first
+        if r.uv_faces is not None and self.uv_r is not None:
             self.faces = r.uv_faces
-            geo_of = np.empty(r._uv.n_vertices, np.int64)
-            geo_of[: len(w.corner_first)] = w.geo[w.corner_first]  # unused corners keep their vertex
+            geo_of = np.empty(self.uv_r.n_vertices, np.int64)
+            geo_of[: len(self.corner_first)] = w.geo[self.corner_first]  # unused corners keep their vertex
             geo_of[r.uv_faces.ravel()] = r.faces.ravel()
             self.geo_of = geo_of
-        else:
-            self.faces = r.faces
-            self.geo_of = None
 
     def positions(self) -> np.ndarray:
         V2 = self.r.apply(self.w.V)
@@ -253,16 +258,15 @@ class _Output:
 
     def vertex_data(self, a, name: tuple) -> np.ndarray:
         """Refine an (n, ...) per-mesh-vertex array: on the surface, or per corner if it varies."""
-        w = self.w
         A = np.asarray(a)
-        if name in w.varying:
-            return _refine_vertex_data(self.r._uv, A[w.corner_first])
-        out = _refine_vertex_data(self.r, A[w.geo_first])
+        if name in self.w.varying and self.uv_r is not None:
+            return _refine_vertex_data(self.uv_r, A[self.corner_first])
+        out = _refine_vertex_data(self.r, A[self.w.geo_first])
         return out if self.geo_of is None else out[self.geo_of]
 
     def uv(self, uv: np.ndarray) -> np.ndarray:
-        if self.w.face_varying:
-            return self.r._uv.apply(uv[self.w.corner_first])
+        if self.uv_r is not None:
+            return self.uv_r.apply(uv[self.corner_first])
         return self.r.apply(uv[self.w.geo_first])
 
     def vertices_of(self, v: np.ndarray) -> np.ndarray:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -106,7 +107,8 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
     OBJ (with OpenSubdiv's ``t crease`` / ``t corner`` tags), PLY (with ``edge``, ``corner``
     and ``sharp_face`` elements) and OFF are read by hybridsub, keeping every vertex where
     the file has it; any other format trimesh reads (STL, GLB, glTF, 3MF, …) is read through
-    trimesh (STL's separate triangles are welded into one surface).
+    trimesh (STL's separate triangles are welded into one surface, and so are the vertices a
+    textured glTF duplicates along its UV seams, its UVs kept per face corner).
 
     Parameters
     ----------
@@ -215,7 +217,10 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
     faces, fuv = fast
     v_rows = _fast_table(v_lines) if v_lines else []
     vt_rows = _fast_table(vt_lines)
-    vt_rows = vt_rows[:, :2] if isinstance(vt_rows, np.ndarray) else [ln.split()[:2] for ln in vt_lines]
+    if isinstance(vt_rows, np.ndarray):  # 'vt u' alone means v = 0; a third number (w) is not used
+        vt_rows = np.pad(vt_rows[:, :2], ((0, 0), (0, 2 - min(vt_rows.shape[1], 2))))
+    else:
+        vt_rows = [ln.split()[:2] for ln in vt_lines]
     return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate)
 
 
@@ -813,7 +818,7 @@ def _write_trimesh(path: str, m: TaggedMesh, ext: str) -> None:
     if kind not in trimesh.exchange.export._mesh_exporters:
         raise MeshError(f"{path}: trimesh cannot write {ext or '(no extension)'!r} files; known: "
                         + ", ".join(sorted(trimesh.exchange.export._mesh_exporters)))
-    visual = None
+    visual: Any = None
     V, F = m.vertices, m.faces
     if m.vertex_colors is not None:
         visual = trimesh.visual.ColorVisuals(vertex_colors=np.clip(np.round(m.vertex_colors * 255), 0, 255)

@@ -120,6 +120,16 @@ t interpolateboundary 1/0/0 2
     assert len(F2) == 48
 
 
+def test_obj_vt_with_one_or_three_numbers(tmp_path):
+    """'vt u' means v = 0; 'vt u v w' keeps u and v (both OBJ forms exist in the wild)."""
+    head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+    for vt, want in (("vt 0.5\nvt 0.25\nvt 1\n", [[0.5, 0], [0.25, 0], [1, 0]]),
+                     ("vt 0.5 0.1 0.3\nvt 0.25 0.2 0\nvt 1 0.1 0.3\n", [[0.5, 0.1], [0.25, 0.2], [1, 0.1]]),
+                     ("vt 0.5\nvt 0.25 0.2\nvt 1 0.1 0.3\n", [[0.5, 0], [0.25, 0.2], [1, 0.1]])):
+        m = read_mesh(_write(tmp_path / "t.obj", head + vt + "f 1/1 2/2 3/3\n"))
+        assert m.uv.tolist() == want and m.face_uv.tolist() == [[0, 1, 2]]
+
+
 def test_tag_variants(tmp_path):
     text = """v 0 0 0
 v 1 0 0
