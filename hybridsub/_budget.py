@@ -22,6 +22,7 @@ asking for levels that cannot fit, not an exact account.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -253,15 +254,20 @@ class Budget:
         self.keeps_steps = keeps_steps
         self.limit, self.source = _resolve(max_memory)
 
-    def check(self, step: int, level, plan) -> None:
+    def check(self, step: int, level, plan, also: tuple | None = None) -> None:
         """Refuse (OutputTooLargeError) if the steps ``1 .. levels`` would not fit.
 
         Called before every step; the estimate is made once, before the first step allocates
         anything, from that step's exact counts and upper bounds for the steps after it.
+        ``also``: a second (level, plan) refined alongside (a UV index mesh), whose memory
+        is added.
         """
         if step != 1 or not math.isfinite(self.limit):
             return
         est = estimate(counts_of(level, plan), self.scheme, step, self.levels, self.keeps_steps)
+        if also is not None:
+            extra = estimate(counts_of(*also), self.scheme, step, self.levels, self.keeps_steps)
+            est = dataclasses.replace(est, nnz=est.nnz + extra.nnz, bytes=est.bytes + extra.bytes)
         if est.bytes > self.limit:
             raise OutputTooLargeError(self.message(est, level, step))
 

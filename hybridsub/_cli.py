@@ -20,6 +20,7 @@ from . import __version__
 from . import _io
 from ._errors import MeshError, OutputTooLargeError
 from ._examples import example_path
+from ._facevarying import seam_edges
 from ._features import detect_features
 from ._io import TaggedMesh
 from ._meshinfo import _edges, mesh_report, predict_levels
@@ -221,9 +222,35 @@ def _bytes(b: float) -> str:
     return f"{int(b)} B"
 
 
-def _predict(mesh: TaggedMesh, levels: int, scheme: str, feat: Features, attributes: int = 3):
-    return predict_levels(mesh.faces, len(mesh.vertices), levels, scheme=scheme, sharp_edges=feat.sharp_edges,
-                          sharpness=feat.sharpness, sharp_faces=feat.sharp_faces, attributes=attributes)
+def _keeps_uv(mesh: TaggedMesh, scheme: str) -> bool:
+    """Whether subdivide refines the mesh's UVs (face-varying); Kobbelt's √3 cannot."""
+    return mesh.uv is not None and mesh.face_uv is not None and scheme != "sqrt3"
+
+
+def _seams(mesh: TaggedMesh, path: str) -> np.ndarray:
+    try:
+        return seam_edges(mesh.faces, mesh.face_uv)
+    except MeshError as e:
+        raise CLIError(f"{path}: {e}") from None
+
+
+def _predict(mesh: TaggedMesh, levels: int, scheme: str, feat: Features, attributes: int = 3, path: str = "",
+             uv: bool = True):
+    """Exact counts per level of ``subdivide`` (UV seams are split edges for ever, as
+    infinitely sharp creases are); the UV index mesh roughly doubles the peak memory.
+    ``uv=False``: the mesh without its UVs (``compare``)."""
+    edges, sharpness = feat.sharp_edges, feat.sharpness
+    uv = uv and _keeps_uv(mesh, scheme)
+    if uv and scheme == "hybrid":
+        seams = _seams(mesh, path)
+        edges = np.vstack([edges, seams])
+        sharpness = np.concatenate([sharpness, np.full(len(seams), np.inf)])
+    pred = predict_levels(mesh.faces, len(mesh.vertices), levels, scheme=scheme, sharp_edges=edges,
+                          sharpness=sharpness, sharp_faces=feat.sharp_faces, attributes=attributes)
+    if uv:
+        for p in pred:
+            p["peak_bytes"] *= 2
+    return pred
 
 
 def cmd_subdivide(a) -> int:
@@ -255,21 +282,24 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     """Refine mesh with its attributes, level by level, with the progress bar."""
     cols = [mesh.vertices]
     vc = mesh.vertex_colors
-    vuv = mesh.vertex_uv
     if vc is not None:
         cols.append(vc)
-    if vuv is not None:
-        cols.append(vuv)
-    elif mesh.uv is not None:
-        _say(a, "note: texture coordinates dropped: they have seams (a vertex with different UVs in "
-                "different faces), which the command line does not refine yet")
+    uv_mode = getattr(a, "uv_mode", None)
+    keep_uv = _keeps_uv(mesh, scheme)
+    if mesh.uv is not None and not keep_uv:
+        if uv_mode is not None:
+            raise CLIError("--uv-mode needs --scheme hybrid or loop: Kobbelt's √3 flips every edge, and a flip "
+                           f"across a UV seam makes a triangle spanning two UV charts ({path} has UVs)")
+        _say(a, f"note: texture coordinates dropped: Kobbelt's √3 cannot keep UV seams (use --scheme hybrid "
+                "to keep them)")
     X = np.hstack(cols)
-    pred = _predict(mesh, levels, scheme, feat, attributes=X.shape[1])
+    pred = _predict(mesh, levels, scheme, feat, attributes=X.shape[1], path=path)
     _check_memory(a, pred, f"{levels} levels of {scheme}")
     bar = ProgressBar([p["faces"] for p in pred], scheme, enabled=not a.quiet and sys.stderr.isatty())
+    uv_args = dict(uv=mesh.uv, face_uv=mesh.face_uv, uv_mode=uv_mode or "linear") if keep_uv else {}
     try:
         res = refine_by_level(X, mesh.faces, levels, scheme=scheme, loop_weights=a.loop_weights,
-                              on_level=bar.update, max_memory="none" if a.force else None, **feat.tags())
+                              on_level=bar.update, max_memory="none" if a.force else None, **uv_args, **feat.tags())
     except MeshError as e:
         raise CLIError(f"{path}: {e}") from None
     except OutputTooLargeError as e:  # the library's memory limit (HYBRIDSUB_MAX_MEMORY); --force lifts it
@@ -285,8 +315,8 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     if vc is not None:
         colors = np.clip(Y[:, k:k + vc.shape[1]], 0, 1)
         k += vc.shape[1]
-    if vuv is not None:
-        uv, face_uv = np.ascontiguousarray(Y[:, k:k + 2]), res.faces
+    if keep_uv:
+        uv, face_uv = res.uv, res.face_uv
     sf = res.sharp_faces
     out = TaggedMesh(V, res.faces, res.sharp_edges, res.sharpness, res.corners,
                      np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv)
@@ -304,7 +334,7 @@ def cmd_compare(a) -> int:
     feat = gather_features(a, mesh, a.input, "hybrid", default_angle=30.0)
     _say(a, feat.summary)
     for scheme in ("hybrid", "loop"):
-        _check_memory(a, _predict(mesh, a.levels, scheme, feat), f"{a.levels} levels of {scheme}")
+        _check_memory(a, _predict(mesh, a.levels, scheme, feat, uv=False), f"{a.levels} levels of {scheme}")
     t = time.perf_counter()
     try:
         panels = compare_panels(mesh.vertices, mesh.faces, a.levels, loop_weights=a.loop_weights, **feat.tags())
@@ -389,8 +419,13 @@ def cmd_info(a) -> int:
     lines.append(f"  detected      {_n(len(det.sharp_edges), 'crease')} (dihedral > {angle:g}°), "
                  f"{_n(len(det.corners), 'corner')}")
     out["detected"] = {"angle": angle, "sharp_edges": len(det.sharp_edges), "corners": len(det.corners)}
+    if mesh.uv is not None and mesh.face_uv is not None:
+        k = len(_seams(mesh, a.input))
+        lines.append(f"  texture       {_n(len(mesh.uv), 'UV value')}, {_n(k, 'seam')} (refined face-varying, "
+                     "seams split; --scheme sqrt3 drops UVs)")
+        out["texture"] = {"uv_values": len(mesh.uv), "seams": k}
     feat = gather_features(a, mesh, a.input, a.scheme)
-    pred = _predict(mesh, a.levels, a.scheme, feat)
+    pred = _predict(mesh, a.levels, a.scheme, feat, path=a.input)
     out["features"] = feat.summary
     out["levels"] = pred
     lines.append(f"  subdivide     --scheme {a.scheme}: {feat.summary}")
@@ -399,7 +434,8 @@ def cmd_info(a) -> int:
         lines.append(f"                {p['level']:>5} {p['faces']:>12,} {p['vertices']:>12,}  "
                      f"{_bytes(p['output_bytes']):>9}  {_bytes(p['peak_bytes']):>9}")
     lines.append("                counts are exact; memory is estimated from them (output: float64 positions and")
-    lines.append("                int64 faces; peak: hybridsub subdivide making that level, holding it and the one before)")
+    lines.append("                int64 faces; peak: hybridsub subdivide making that level, holding it and the one before"
+                 + (", and the UV index mesh's)" if _keeps_uv(mesh, a.scheme) else ")"))
     return _emit(a, lines, out, 0)
 
 
@@ -521,6 +557,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", metavar="OUT", required=True, help="output file; its extension picks the format")
     s.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
     _tag_options(s)
+    s.add_argument("--uv-mode", choices=("linear", "smooth"),
+                   help="texture coordinates (OBJ vt, PLY s t): linear (default) interpolates them, seams kept, "
+                        "the texture undistorted; smooth subdivides them like the positions")
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
     s.add_argument("--ascii", action="store_true", help="PLY output in ASCII instead of binary")
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")

@@ -29,16 +29,14 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from . import _kernels as K
+from . import _budget
 from . import _rules as R
 from . import _validate as val
 from ._errors import MeshError
-from ._refine import Refinement, RefinementStep
-from ._stencils import step_matrix
-from ._topology import Level, child_creases, child_level, face_parents, plan_step
-from ._typing import ArrayLike, LoopWeights, Scheme, UVMode
-
-UV_MODES = ("linear", "smooth")
+from ._refine import Refinement, RefinementStep, check_uv_mode
+from ._stencils import apply_matrix, apply_step, step_matrix
+from ._topology import Level, StepPlan, child_creases, child_level, face_parents, plan_step
+from ._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 
 
 class FaceVaryingRefinement(NamedTuple):
@@ -48,7 +46,9 @@ class FaceVaryingRefinement(NamedTuple):
     ----------
     geometry : Refinement
         The mesh's refinement (seams split, never flipped); ``geometry.apply(V)`` refines
-        positions or any per-vertex data.
+        positions or any per-vertex data. It is what ``refine(F, ..., uv_faces=FUV)``
+        returns: ``geometry.uv_faces is uv.faces`` and ``geometry.uv_matrix`` is
+        ``uv.matrix``.
     uv : Refinement
         The UV index mesh's refinement: ``uv.faces`` is ``FUV'`` (row ``f`` is the same
         triangle as ``geometry.faces[f]``), ``uv.apply(UV)`` refines UVs or any per-UV-index
@@ -86,7 +86,7 @@ def seam_edges(F: ArrayLike, FUV: ArrayLike) -> np.ndarray:
     [[2, 0]]
     """
     Fi, n = val.as_faces(F, None)
-    T = _as_uv_faces(FUV, len(Fi), None)
+    T = as_uv_faces(FUV, len(Fi), None)
     if not len(Fi):
         return np.empty((0, 2), np.int64)
     level = val.checked_level(Fi, n)
@@ -98,8 +98,14 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
                         n_vertices: int | None = None, n_uvs: int | None = None, scheme: Scheme = "hybrid",
                         uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                         sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
-                        loop_weights: LoopWeights = "loop") -> FaceVaryingRefinement:
+                        loop_weights: LoopWeights = "loop", non_manifold: NonManifold = "raise",
+                        max_memory: MemoryLimit = None) -> FaceVaryingRefinement:
     """Refine a mesh's connectivity together with its face-varying (UV) index mesh.
+
+    ``refine(F, ..., uv_faces=FUV)`` returns the ``geometry`` part of this, with the UV faces
+    and matrices attached (``uv_faces``, ``uv_matrix``); this function also returns the UV
+    index mesh's own :class:`Refinement` (``uv.apply``, its steps, its carried creases and
+    UV corners).
 
     Parameters
     ----------
@@ -108,7 +114,7 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     FUV : (m, 3) array_like of int
         UV index of each face corner (row ``f`` belongs to face ``f``); a face may repeat a UV
         index (a degenerate UV triangle).
-    sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights
+    sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights, non_manifold, max_memory
         As in :func:`hybridsub.refine`.
     n_vertices : int, optional
         Number of vertices; default ``F.max() + 1``.
@@ -136,74 +142,100 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     >>> geo.faces.shape, uv.faces.shape, geo.matrix.shape, uv.matrix.shape
     ((12, 3), (12, 3), (11, 4), (14, 6))
     """
-    levels = val.check_options(scheme, levels, loop_weights)
-    if scheme == "sqrt3":
-        raise ValueError(
-            'scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every edge, and a flip across a seam '
-            'makes a triangle spanning two UV charts); use scheme="hybrid" (√3 with seams split) or "loop"'
-        )
-    if uv_mode not in UV_MODES:
-        raise ValueError(f"uv_mode must be one of {UV_MODES}, got {uv_mode!r}")
-    Fi, n = val.as_faces(F, n_vertices)
-    m = len(Fi)
-    T = _as_uv_faces(FUV, m, n_uvs)
-    t = int(n_uvs) if n_uvs is not None else (int(T.max()) + 1 if T.size else 0)
-    pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
-    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, m)
-    corner = val.as_corner_mask(corners, n)
-    if scheme == "loop":
-        face_sharp[:] = True
-    keep = sharp > 0
-    pairs, sharp = pairs[keep], sharp[keep]
+    from ._refine import refine
 
-    def faces_out(mask):
-        return np.flatnonzero(mask) if faces_as_indices else mask
+    geo = refine(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
+                 sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
+                 max_memory=max_memory, uv_faces=FUV, n_uvs=n_uvs, uv_mode=uv_mode)
+    assert geo._uv is not None  # refine attaches it whenever uv_faces is given
+    return FaceVaryingRefinement(geo, geo._uv)
 
-    corners_out = np.flatnonzero(corner)
-    if m == 0:  # no faces: nothing to refine, every level is the input
-        return _unrefined(Fi, T, n, t, pairs, sharp, faces_out, face_sharp, corners_out, levels)
 
+def refine_with_uvs(F, FUV, sharp_edges, levels, *, n_vertices, n_uvs, scheme, uv_mode, sharpness, sharp_faces,
+                    corners, loop_weights, max_memory) -> Refinement:
+    """``refine(..., uv_faces=FUV)``: the geometry's Refinement with the UV index mesh's attached."""
+    setup = _setup(F, FUV, sharp_edges, levels, n_vertices, n_uvs, scheme, uv_mode, sharpness, sharp_faces, corners,
+                   loop_weights, uv_name="uv_faces")
+    faces_out = setup.faces_out
+    Fi, T, n, t = setup.F, setup.T, setup.n, setup.t
+    pairs, sharp, corners_out = setup.pairs, setup.sharp, setup.corners_out
+    if len(Fi) == 0:  # no faces: nothing to refine, every level is the input
+        return _unrefined(setup)
+    budget = _budget.Budget(setup.levels, scheme, max_memory)
     geo_steps, uv_steps = [], []
-    face_parent = np.arange(m, dtype=np.int64)
-    level = val.checked_level(Fi, n, pairs).tag(pairs, sharp, face_sharp)
-    uvl = _uv_level(level, T, t)
-    uv_corner = _carried_corners(level, uvl, corner)
-    uv_corners_out = np.flatnonzero(uv_corner | _irregular_uv(level, uvl))
+    face_parent = np.arange(len(Fi), dtype=np.int64)
     uv_pairs, uv_sharp = np.empty((0, 2), np.int64), np.empty(0)
-    for step in range(1, levels + 1):
-        plan = plan_step(level, corner, scheme, step, loop_weights, force_split=_seam_halfedges(level, uvl.faces))
-        # The UV index mesh: the same split/flip decisions, its boundary (mesh boundary and
-        # seams) as creases, geometric creases and corners carried onto it.
-        uv_fixed = uv_corner | _irregular_uv(level, uvl)
-        uv_plan = plan_step(uvl, uv_fixed, scheme, step, loop_weights, force_split=plan.hkind == R.EDGE_SPLIT)
-        if not np.array_equal(uv_plan.hkind, plan.hkind):
-            raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
-        S = step_matrix(level, plan)
-        S_uv = step_matrix(uvl, uv_plan) if uv_mode == "smooth" else _linear_matrix(uvl, uv_plan)
-        pairs, sharp = child_creases(level, plan)
-        uv_pairs, uv_sharp = child_creases(uvl, uv_plan)
-        faces, child, offsets = child_level(level, plan)
-        uv_faces, uv_child, _ = child_level(uvl, uv_plan)
-        parent = face_parents(offsets)
+    uv_corners_out = np.empty(0, np.int64)
+    level: Level | None = None
+    uvl: Level | None = None
+    for s in _walk(setup, budget):
+        level, uvl = s.child, s.uv_child
+        uv_corners_out = s.uv_corners_in
+        S = step_matrix(s.level, s.plan)
+        S_uv = step_matrix(s.uvl, s.uv_plan) if uv_mode == "smooth" else _linear_matrix(s.uvl, s.uv_plan)
+        pairs, sharp = child_creases(s.level, s.plan)
+        uv_pairs, uv_sharp = child_creases(s.uvl, s.uv_plan)
+        parent = face_parents(s.offsets)
         face_parent = face_parent[parent]
-        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
-        uv_corner = np.concatenate([uv_corner, np.zeros(uv_plan.n_new - len(uv_corner), dtype=bool)])
-        mask = faces_out(child.face_sharp)
-        geo_steps.append(RefinementStep(faces, S, pairs, sharp, mask, corners_out, parent))
-        uv_steps.append(RefinementStep(uv_faces, S_uv, uv_pairs, uv_sharp, mask, uv_corners_out, parent))
-        level, uvl = child, uv_child
-    geo = Refinement(level.faces if levels else Fi.copy(), pairs, sharp, faces_out(level.face_sharp), corners_out,
-                     face_parent, geo_steps, n)
-    uv = Refinement(uvl.faces if levels else T.copy(), uv_pairs, uv_sharp, faces_out(level.face_sharp),
-                    uv_corners_out, face_parent.copy(), uv_steps, t)
-    return FaceVaryingRefinement(geo, uv)
+        mask = faces_out(level.face_sharp)
+        geo_steps.append(RefinementStep(s.faces, S, pairs, sharp, mask, corners_out, parent, s.uv_faces, S_uv))
+        uv_steps.append(RefinementStep(s.uv_faces, S_uv, uv_pairs, uv_sharp, mask, uv_corners_out, parent))
+    if level is None or uvl is None:  # levels == 0: the input, checked
+        level = val.checked_level(Fi, n, pairs)
+        uv_corners_out = _uv_corners(level.tag(pairs, sharp, setup.face_sharp), T, t, setup.corner)
+        geo_faces, uv_faces, sharp_mask = Fi.copy(), T.copy(), faces_out(setup.face_sharp)
+    else:
+        geo_faces, uv_faces, sharp_mask = level.faces, uvl.faces, faces_out(level.face_sharp)
+    uv = Refinement(uv_faces, uv_pairs, uv_sharp, sharp_mask, uv_corners_out, face_parent.copy(), uv_steps, t)
+    geo = Refinement(geo_faces, pairs, sharp, sharp_mask, corners_out, face_parent, geo_steps, n, _uv=uv)
+    geo._cache["max_memory"] = uv._cache["max_memory"] = max_memory
+    return geo
+
+
+class FaceVaryingLevel(NamedTuple):
+    """One level of :func:`subdivide_face_varying_levels`."""
+
+    step: int
+    X: np.ndarray  # (n_k, d) refined per-vertex data
+    faces: np.ndarray  # (m_k, 3)
+    UV: np.ndarray  # (t_k, e) refined per-UV-index data
+    uv_faces: np.ndarray  # (m_k, 3), aligned with faces
+    face_parent: np.ndarray  # (m_k,) face of the previous level each face came from
+    sharp_edges: np.ndarray  # tags of this level
+    sharpness: np.ndarray
+    sharp_faces: np.ndarray  # (m_k,) bool mask
+
+
+def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_edges=None, levels: int = 1, *,
+                                  scheme="hybrid", uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
+                                  loop_weights="loop", max_memory=None):
+    """The face-varying fast path: yield a :class:`FaceVaryingLevel` per step, no matrix kept.
+
+    ``X (n, d)`` and ``UV (t, e)`` are float64, already validated. The same numbers as
+    ``refine(..., uv_faces=FUV)``'s step matrices applied one after the other, bit for bit
+    (the stencils are applied directly, as in :func:`hybridsub.subdivide`); only two levels
+    are held at a time (the command line's progress bar runs on it).
+    """
+    setup = _setup(F, FUV, sharp_edges, levels, len(X), len(UV), scheme, uv_mode, sharpness, sharp_faces, corners,
+                   loop_weights)
+    budget = _budget.Budget(setup.levels, scheme, max_memory, keeps_steps=False)
+    for s in _walk(setup, budget):
+        X = apply_step(s.level, s.plan, X)
+        if uv_mode == "smooth":
+            UV = apply_step(s.uvl, s.uv_plan, UV)
+        else:
+            UV = _linear_apply(s.uvl, s.uv_plan, UV)
+        pairs, sharp = child_creases(s.level, s.plan)
+        yield FaceVaryingLevel(s.step, X, s.faces, UV, s.uv_faces, face_parents(s.offsets), pairs, sharp,
+                               s.child.face_sharp)
 
 
 def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: ArrayLike,
                            sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = "hybrid",
                            uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                            sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
-                           loop_weights: LoopWeights = "loop", return_matrix: bool = False) -> tuple:
+                           loop_weights: LoopWeights = "loop", return_matrix: bool = False,
+                           max_memory: MemoryLimit = None) -> tuple:
     """Subdivide a textured triangle mesh: positions and UVs with seams, faces kept aligned.
 
     Parameters
@@ -216,7 +248,7 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
         Face-varying values (UVs, usually k = 2; any per-corner data works).
     FUV : (m, 3) array_like of int
         Index into ``UV`` of each face corner, aligned row by row with ``F``.
-    sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights
+    sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights, max_memory
         As in :func:`hybridsub.subdivide`.
     scheme : {"hybrid", "loop"}
         ``"hybrid"`` splits seam edges (R4) instead of flipping them, so its geometry differs
@@ -252,17 +284,132 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
     A = np.asarray(V)
     Vf = val.as_vertices(A)
     UVf = _as_uv_values(UV)
-    r = refine_face_varying(F, FUV, sharp_edges, levels, n_vertices=len(Vf), n_uvs=len(UVf), scheme=scheme,
-                            uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                            loop_weights=loop_weights)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
-    V2 = r.geometry.apply(Vf).astype(out_dtype, copy=False)
     U = np.asarray(UV)
     uv_dtype = U.dtype if np.issubdtype(U.dtype, np.floating) else np.float64
-    UV2 = r.uv.apply(UVf).astype(uv_dtype, copy=False)
     if return_matrix:
+        r = refine_face_varying(F, FUV, sharp_edges, levels, n_vertices=len(Vf), n_uvs=len(UVf), scheme=scheme,
+                                uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
+                                loop_weights=loop_weights, max_memory=max_memory)
+        V2 = r.geometry.apply(Vf).astype(out_dtype, copy=False)
+        UV2 = r.uv.apply(UVf).astype(uv_dtype, copy=False)
         return V2, r.geometry.faces, UV2, r.uv.faces, r.geometry.matrix, r.uv.matrix
-    return V2, r.geometry.faces, UV2, r.uv.faces
+    shape = UVf.shape
+    last = None
+    for last in subdivide_face_varying_levels(Vf, F, UVf.reshape(len(UVf), -1), FUV, sharp_edges, levels,
+                                              scheme=scheme, uv_mode=uv_mode, sharpness=sharpness,
+                                              sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                                              max_memory=max_memory):
+        pass
+    if last is None:  # no step ran: copies of the input
+        Fi, _ = val.as_faces(F, len(Vf))
+        T = as_uv_faces(FUV, len(Fi), len(UVf))
+        return Vf.astype(out_dtype, copy=True), Fi.copy(), UVf.astype(uv_dtype, copy=True), T.copy()
+    UV2 = last.UV.reshape((len(last.UV),) + shape[1:])
+    return (last.X.astype(out_dtype, copy=False), last.faces, UV2.astype(uv_dtype, copy=False), last.uv_faces)
+
+
+# ---------------------------------------------------------------------------------------
+# The step loop.
+
+
+class _Setup(NamedTuple):
+    """Checked and normalised arguments of one face-varying refinement."""
+
+    levels: int
+    F: np.ndarray
+    T: np.ndarray  # (m, 3) UV faces
+    n: int
+    t: int
+    scheme: str
+    pairs: np.ndarray
+    sharp: np.ndarray
+    face_sharp: np.ndarray
+    corner: np.ndarray
+    corners_out: np.ndarray
+    faces_as_indices: bool
+    loop_weights: str
+
+    def faces_out(self, mask):
+        return np.flatnonzero(mask) if self.faces_as_indices else mask
+
+
+def _setup(F, FUV, sharp_edges, levels, n_vertices, n_uvs, scheme, uv_mode, sharpness, sharp_faces, corners,
+           loop_weights, uv_name="FUV") -> _Setup:
+    levels = val.check_options(scheme, levels, loop_weights)
+    if scheme == "sqrt3":
+        raise ValueError(
+            'scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every edge, and a flip across a seam '
+            'makes a triangle spanning two UV charts); use scheme="hybrid" (√3 with seams split) or "loop"'
+        )
+    check_uv_mode(uv_mode)
+    Fi, n = val.as_faces(F, n_vertices)
+    m = len(Fi)
+    if n_uvs is not None:
+        n_uvs = val.count(n_uvs, "n_uvs")
+    T = as_uv_faces(FUV, m, n_uvs, uv_name)
+    t = n_uvs if n_uvs is not None else (int(T.max()) + 1 if T.size else 0)
+    pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
+    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, m)
+    corner = val.as_corner_mask(corners, n)
+    if scheme == "loop":
+        face_sharp[:] = True
+    keep = sharp > 0
+    return _Setup(levels, Fi, T, n, t, scheme, pairs[keep], sharp[keep], face_sharp, corner, np.flatnonzero(corner),
+                  faces_as_indices, loop_weights)
+
+
+class _Step(NamedTuple):
+    step: int
+    level: Level  # geometry of level k, and its plan
+    plan: StepPlan
+    uvl: Level  # UV index mesh of level k, and its plan
+    uv_plan: StepPlan
+    faces: np.ndarray  # faces of level k + 1
+    uv_faces: np.ndarray
+    child: Level  # level k + 1
+    uv_child: Level
+    offsets: np.ndarray  # child offsets of the faces of level k
+    uv_corners_in: np.ndarray  # UV corners of level 0 (indices)
+
+
+def _walk(setup: _Setup, budget=None):
+    """Run the steps on the geometry and the UV index mesh side by side; yield a _Step each.
+
+    Each step plans the geometry with seams as forced splits, then the UV index mesh (its
+    boundary is the mesh boundary and both sides of every seam) with the geometry's split
+    edges as forced splits, so both make the same decisions and emit aligned faces.
+    """
+    if setup.levels == 0 or len(setup.F) == 0:
+        return
+    scheme, loop_weights = setup.scheme, setup.loop_weights
+    corner = setup.corner
+    level = val.checked_level(setup.F, setup.n, setup.pairs).tag(setup.pairs, setup.sharp, setup.face_sharp)
+    uvl = _uv_level(level, setup.T, setup.t)
+    # UV corners: carried corner tags and irregular UV indices. Both keep their status from
+    # level to level, and new UV values are neither (each lies on one new vertex, in one sector).
+    uv_fixed = _carried_corners(level, uvl, corner) | _irregular_uv(level, uvl)
+    uv_corners_in = np.flatnonzero(uv_fixed)
+    for step in range(1, setup.levels + 1):
+        seams = (uvl.twin < 0) & (level.twin >= 0)  # the UV mesh is cut exactly along the seams
+        plan = plan_step(level, corner, scheme, step, loop_weights, force_split=seams)
+        uv_plan = plan_step(uvl, uv_fixed, scheme, step, loop_weights, force_split=plan.hkind == R.EDGE_SPLIT)
+        if not np.array_equal(uv_plan.hkind, plan.hkind):
+            raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
+        if budget is not None:
+            budget.check(step, level, plan, also=(uvl, uv_plan))  # before this step allocates anything large
+        faces, child, offsets = child_level(level, plan)
+        uv_faces, uv_child, _ = child_level(uvl, uv_plan)
+        yield _Step(step, level, plan, uvl, uv_plan, faces, uv_faces, child, uv_child, offsets, uv_corners_in)
+        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
+        uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
+        level, uvl = child, uv_child
+
+
+def _uv_corners(level: Level, T: np.ndarray, t: int, corner: np.ndarray) -> np.ndarray:
+    """UV corners of level 0 (indices), for a refinement without steps."""
+    uvl = _uv_level(level, T, t)
+    return np.flatnonzero(_carried_corners(level, uvl, corner) | _irregular_uv(level, uvl))
 
 
 # ---------------------------------------------------------------------------------------
@@ -316,41 +463,82 @@ def _carried_corners(level: Level, uvl: Level, corner: np.ndarray) -> np.ndarray
     return out
 
 
-def _linear_matrix(uvl: Level, plan) -> sp.csr_matrix:
-    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids."""
+def _linear_rows(uvl: Level, plan) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The UV edges (k, 2) and UV faces (l, 3) of ``uv_mode="linear"``'s new values, in
+    ``plan``'s layout (old values, then edge points, then face points), each row sorted; and
+    whether one repeats a UV index (a degenerate UV edge or face)."""
     t = uvl.n_vertices
-    owner = uvl.edge_owner
-    has_point = plan.edge_point[owner] >= 0
-    e = owner[has_point]
+    h = np.flatnonzero(plan.edge_point >= 0)
+    h = h[(uvl.twin[h] < 0) | (h < uvl.twin[h])]  # one halfedge per split edge
+    fv = uvl.faces.ravel()
+    E = np.empty((len(h), 2), np.int64)
+    E[plan.edge_point[h] - t] = np.sort(np.stack([fv[h], fv[h - h % 3 + (h % 3 + 1) % 3]], axis=1), axis=1)
     f = np.flatnonzero(plan.face_point >= 0)
-    rows = np.concatenate([np.arange(t), np.repeat(plan.edge_point[e], 2), np.repeat(plan.face_point[f], 3)])
-    cols = np.concatenate([np.arange(t), uvl.edge_vertices[has_point].ravel(), uvl.faces[f].ravel()])
-    data = np.concatenate([np.ones(t), np.full(2 * len(e), 0.5), np.full(3 * len(f), 1.0 / 3.0)])
-    S = sp.csr_matrix((data, (rows, cols)), shape=(plan.n_new, t))
-    S.sum_duplicates()  # a degenerate UV edge (p, p) gives one entry 1.0
+    T = np.empty((len(f), 3), np.int64)
+    T[plan.face_point[f] - t - len(h)] = np.sort(uvl.faces[f], axis=1)
+    return E, T, bool((E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any())
+
+
+def _linear_matrix(uvl: Level, plan) -> sp.csr_matrix:
+    """UV matrix of ``uv_mode="linear"``: old values kept, midpoints, centroids (CSR, built
+    directly, columns sorted)."""
+    t = uvl.n_vertices
+    E, T, degenerate = _linear_rows(uvl, plan)
+    indptr = np.concatenate([np.arange(t + 1), t + 2 * np.arange(1, len(E) + 1),
+                             t + 2 * len(E) + 3 * np.arange(1, len(T) + 1)])
+    indices = np.concatenate([np.arange(t), E.ravel(), T.ravel()])
+    data = np.concatenate([np.ones(t), np.full(E.size, 0.5), np.full(T.size, 1.0 / 3.0)])
+    S = sp.csr_matrix((data, indices, indptr), shape=(plan.n_new, t))
+    if degenerate:
+        S.sum_duplicates()  # a degenerate UV edge (p, p) gives one entry 1.0
+    S.has_sorted_indices = True
     return S
+
+
+def _linear_apply(uvl: Level, plan, UV: np.ndarray) -> np.ndarray:
+    """``_linear_matrix(uvl, plan) @ UV`` without forming it: the same sums in the same order,
+    so the same bits (a degenerate UV edge or face goes through the matrix, whose merged
+    entries sum differently)."""
+    E, T, degenerate = _linear_rows(uvl, plan)
+    if degenerate:
+        return apply_matrix(_linear_matrix(uvl, plan), UV)
+    t, w = uvl.n_vertices, 1.0 / 3.0
+    out = np.empty((plan.n_new, UV.shape[1]))
+    out[:t] = UV
+    out[t:t + len(E)] = 0.5 * UV[E[:, 0]] + 0.5 * UV[E[:, 1]]
+    out[t + len(E):] = w * UV[T[:, 0]] + w * UV[T[:, 1]] + w * UV[T[:, 2]]
+    return out
 
 
 # ---------------------------------------------------------------------------------------
 # Input checking.
 
 
-def _as_uv_faces(FUV, m: int, n_uvs) -> np.ndarray:
-    A = np.asarray(FUV)
+def as_uv_faces(FUV, m: int, n_uvs: int | None, name: str = "FUV") -> np.ndarray:
+    """(m, 3) int64 UV faces, checked against the ``m`` faces and ``n_uvs`` UV values; errors
+    name the argument (``name``) and the first bad face."""
+    A = val.as_array(FUV, name, 3, "face", "m")
+    if A.ndim == 1 and A.size == 0 and m == 0:
+        A = A.reshape(0, 3)
+    if A.dtype == bool or not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
+        raise TypeError(f"{name} must hold integer UV indices, got dtype {A.dtype}")
     if A.ndim != 2 or A.shape[1] != 3 or A.shape[0] != m:
-        raise MeshError(f"FUV must have shape ({m}, 3), one row of UV indices per face, got {A.shape}")
-    if A.dtype == bool or not (np.issubdtype(A.dtype, np.integer) or (
-            np.issubdtype(A.dtype, np.floating) and np.all(np.isfinite(A)) and np.all(A == np.round(A)))):
-        raise TypeError(f"FUV must hold integer UV indices, got dtype {A.dtype}")
+        raise MeshError(f"{name} must have shape ({m}, 3), one row of UV indices per face, got {A.shape}")
+    if np.issubdtype(A.dtype, np.floating) and A.size:
+        frac = val.not_integral(A)
+        if frac.any():
+            f = int(np.flatnonzero(frac)[0])
+            raise MeshError(f"{name} must hold integer UV indices; face {f} has {A[f].tolist()}")
     T = np.ascontiguousarray(A, dtype=np.int64)
     if T.size:
-        if (T < 0).any():
-            f = int(np.flatnonzero((T < 0).any(axis=1))[0])
-            raise MeshError(f"FUV row {f} has a negative UV index: {T[f].tolist()}")
+        neg = (T < 0).any(axis=1)
+        if neg.any():
+            f = int(np.flatnonzero(neg)[0])
+            raise MeshError(f"{name}: face {f} has a negative UV index: {T[f].tolist()}")
         if n_uvs is not None and T.max() >= n_uvs:
             f = int(np.flatnonzero((T >= n_uvs).any(axis=1))[0])
-            raise MeshError(f"FUV row {f} = {T[f].tolist()} refers to UV {int(T[f].max())}, but there are only "
-                            f"{n_uvs} UV values (valid indices 0..{n_uvs - 1})")
+            raise MeshError(f"{name}: face {f} has UV indices {T[f].tolist()}, but there are only {n_uvs} UV values "
+                            f"(valid indices 0..{n_uvs - 1})")
     return T
 
 
@@ -368,15 +556,16 @@ def _as_uv_values(UV) -> np.ndarray:
     return A
 
 
-def _unrefined(Fi, T, n, t, pairs, sharp, faces_out, face_sharp, corners_out, levels):
+def _unrefined(setup: _Setup) -> Refinement:
     """No faces: every level is the input."""
-    m = len(Fi)
-    ident = np.arange(m, dtype=np.int64)
-    geo_steps = [RefinementStep(Fi.copy(), sp.identity(n, format="csr"), pairs, sharp, faces_out(face_sharp),
-                                corners_out, ident) for _ in range(levels)]
-    uv_steps = [RefinementStep(T.copy(), sp.identity(t, format="csr"), np.empty((0, 2), np.int64), np.empty(0),
-                               faces_out(face_sharp), np.empty(0, np.int64), ident) for _ in range(levels)]
-    geo = Refinement(Fi.copy(), pairs, sharp, faces_out(face_sharp), corners_out, ident, geo_steps, n)
-    uv = Refinement(T.copy(), np.empty((0, 2), np.int64), np.empty(0), faces_out(face_sharp),
-                    np.empty(0, np.int64), ident.copy(), uv_steps, t)
-    return FaceVaryingRefinement(geo, uv)
+    Fi, T, n, t = setup.F, setup.T, setup.n, setup.t
+    ident = np.arange(len(Fi), dtype=np.int64)
+    mask = setup.faces_out(setup.face_sharp)
+    no_pairs, no_sharp, no_corners = np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64)
+    geo_steps = [RefinementStep(Fi.copy(), sp.identity(n, format="csr"), setup.pairs, setup.sharp, mask,
+                                setup.corners_out, ident, T.copy(), sp.identity(t, format="csr"))
+                 for _ in range(setup.levels)]
+    uv_steps = [RefinementStep(T.copy(), sp.identity(t, format="csr"), no_pairs, no_sharp, mask, no_corners, ident)
+                for _ in range(setup.levels)]
+    uv = Refinement(T.copy(), no_pairs, no_sharp, mask, no_corners, ident.copy(), uv_steps, t)
+    return Refinement(Fi.copy(), setup.pairs, setup.sharp, mask, setup.corners_out, ident, geo_steps, n, _uv=uv)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -106,7 +107,8 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
     OBJ (with OpenSubdiv's ``t crease`` / ``t corner`` tags), PLY (with ``edge``, ``corner``
     and ``sharp_face`` elements) and OFF are read by hybridsub, keeping every vertex where
     the file has it; any other format trimesh reads (STL, GLB, glTF, 3MF, …) is read through
-    trimesh (STL's separate triangles are welded into one surface).
+    trimesh (STL's separate triangles are welded into one surface, and so are the vertices a
+    textured glTF duplicates along its UV seams, its UVs kept per face corner).
 
     Parameters
     ----------
@@ -215,7 +217,10 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
     faces, fuv = fast
     v_rows = _fast_table(v_lines) if v_lines else []
     vt_rows = _fast_table(vt_lines)
-    vt_rows = vt_rows[:, :2] if isinstance(vt_rows, np.ndarray) else [ln.split()[:2] for ln in vt_lines]
+    if isinstance(vt_rows, np.ndarray):  # 'vt u' alone means v = 0; a third number (w) is not used
+        vt_rows = np.pad(vt_rows[:, :2], ((0, 0), (0, 2 - min(vt_rows.shape[1], 2))))
+    else:
+        vt_rows = [ln.split()[:2] for ln in vt_lines]
     return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate)
 
 
@@ -572,7 +577,14 @@ def _read_trimesh(path: str, ext: str) -> TaggedMesh:
     if kind_v == "vertex":
         colors = np.asarray(mesh.visual.vertex_colors, dtype=np.float64) / 255.0
     elif kind_v == "texture" and getattr(mesh.visual, "uv", None) is not None and len(mesh.visual.uv) == len(V):
+        # UVs per vertex: vertices are duplicated along UV seams. Welded, the UVs become
+        # face-varying and the surface is one piece again.
         uv = np.array(mesh.visual.uv, dtype=np.float64)
+        textured, merged, dropped = weld(TaggedMesh(V, F, uv=uv, face_uv=F.copy()))
+        if merged:
+            notes.append(f"welded {merged} vertices that the file duplicates along UV seams (UVs kept per face "
+                         "corner)" + (f"; dropped {dropped} faces that collapsed" if dropped else ""))
+            return replace(textured, notes=tuple(notes))
         face_uv = F.copy()
     return TaggedMesh(V, F, vertex_colors=colors, uv=uv, face_uv=face_uv, notes=tuple(notes))
 
@@ -806,13 +818,18 @@ def _write_trimesh(path: str, m: TaggedMesh, ext: str) -> None:
     if kind not in trimesh.exchange.export._mesh_exporters:
         raise MeshError(f"{path}: trimesh cannot write {ext or '(no extension)'!r} files; known: "
                         + ", ".join(sorted(trimesh.exchange.export._mesh_exporters)))
-    visual = None
+    visual: Any = None
+    V, F = m.vertices, m.faces
     if m.vertex_colors is not None:
         visual = trimesh.visual.ColorVisuals(vertex_colors=np.clip(np.round(m.vertex_colors * 255), 0, 255)
                                              .astype(np.uint8))
     elif m.vertex_uv is not None:
         visual = trimesh.visual.TextureVisuals(uv=m.vertex_uv)
-    mesh = trimesh.Trimesh(m.vertices, m.faces, visual=visual, process=False)
+    elif m.uv is not None and m.face_uv is not None:  # UV seams: one vertex per (vertex, UV index) pair
+        corner, first = classes([F.ravel(), m.face_uv.ravel()], F.size)
+        V, F = V[F.ravel()[first]], corner.reshape(-1, 3)
+        visual = trimesh.visual.TextureVisuals(uv=m.uv[m.face_uv.ravel()[first]])
+    mesh = trimesh.Trimesh(V, F, visual=visual, process=False)
     try:
         mesh.export(path)
     except Exception as e:
@@ -881,28 +898,46 @@ def _isnum(w: str) -> bool:
         return False
 
 
-def weld(mesh: TaggedMesh) -> tuple[TaggedMesh, int, int]:
-    """Merge vertices at identical positions (first occurrence keeps its place); faces that
-    collapse are dropped. Returns the mesh, the number of vertices merged away, and the number
-    of faces dropped."""
-    V = mesh.vertices
-    _, first, inv = np.unique(V, axis=0, return_index=True, return_inverse=True)
-    inv = inv.ravel()
-    order = np.argsort(first, kind="stable")  # unique rows in order of first appearance
+def classes(arrays: list, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows equal in every one of ``arrays`` (each with ``n`` rows), as classes numbered by
+    first appearance: (class of each row, first row of each class). Positions compare
+    exactly (-0.0 equals 0.0)."""
+    lab = np.zeros(n, np.int64)
+    for A in arrays:
+        A = np.ascontiguousarray(A).reshape(n, -1)
+        if A.dtype.kind == "f":
+            A = A + 0.0
+        _, inv = np.unique(A, axis=0, return_inverse=True)
+        _, lab = np.unique(lab * (int(inv.max(initial=0)) + 1) + inv.ravel(), return_inverse=True)
+        lab = lab.ravel()
+    _, first, inv = np.unique(lab, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
     rank = np.empty(len(order), np.int64)
     rank[order] = np.arange(len(order))
-    new = rank[inv]
-    keep_v = first[order]
+    return rank[inv.ravel()], first[order]
+
+
+def weld(mesh: TaggedMesh) -> tuple[TaggedMesh, int, int]:
+    """Merge vertices at identical positions (first occurrence keeps its place); faces that
+    collapse are dropped. UV indices that end up on one vertex with equal UVs are merged too
+    (so that only real UV seams remain). Returns the mesh, the number of vertices merged
+    away, and the number of faces dropped."""
+    V = mesh.vertices
+    new, keep_v = classes([V], len(V))
     F = new[mesh.faces]
     ok = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
     fmap = np.cumsum(ok) - 1
     E = new[mesh.sharp_edges]
     eok = E[:, 0] != E[:, 1]
     S = mesh.sharp_faces[ok[mesh.sharp_faces]] if len(mesh.sharp_faces) else mesh.sharp_faces
+    uv, face_uv = mesh.uv, mesh.face_uv
+    if uv is not None and face_uv is not None:
+        t = face_uv[ok].ravel()
+        corner, first = classes([F[ok].ravel(), uv[t]], len(t))
+        uv, face_uv = uv[t[first]], corner.reshape(-1, 3)
     out = replace(
         mesh, vertices=V[keep_v], faces=F[ok], sharp_edges=E[eok], sharpness=mesh.sharpness[eok],
         corners=np.unique(new[mesh.corners]), sharp_faces=fmap[S],
-        vertex_colors=None if mesh.vertex_colors is None else mesh.vertex_colors[keep_v],
-        face_uv=None if mesh.face_uv is None else mesh.face_uv[ok],
+        vertex_colors=None if mesh.vertex_colors is None else mesh.vertex_colors[keep_v], uv=uv, face_uv=face_uv,
     )
     return out, len(V) - len(keep_v), int((~ok).sum())

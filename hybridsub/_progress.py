@@ -1,8 +1,9 @@
 """Refinement level by level, with a progress bar on stderr.
 
 The command line refines with :func:`hybridsub._refine.subdivide_levels`, the fast path of
-``subdivide``, which yields each level as it is done with its propagated tags: the bar moves
-per level, only two levels are held at a time, and no matrix is formed.
+``subdivide`` (or, for a mesh with UVs, ``_facevarying.subdivide_face_varying_levels``),
+which yields each level as it is done with its propagated tags: the bar moves per level,
+only two levels are held at a time, and no matrix is formed.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._facevarying import subdivide_face_varying_levels
 from ._refine import subdivide_levels
 
 
@@ -27,14 +29,19 @@ class LevelResult:
     corners: np.ndarray
     face_parent: np.ndarray  # input face of each output face
     seconds: float
+    uv: np.ndarray | None = None  # (t_L, e) refined face-varying data, with uv=
+    face_uv: np.ndarray | None = None  # (m_L, 3) its index of each face corner
 
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
-                    corners=None, loop_weights="loop", on_level=None, max_memory=None) -> LevelResult:
+                    corners=None, loop_weights="loop", on_level=None, max_memory=None, uv=None, face_uv=None,
+                    uv_mode="linear") -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
-    as in :func:`hybridsub.subdivide`.
+    as in :func:`hybridsub.subdivide`. With ``uv (t, e)`` and ``face_uv (m, 3)`` the
+    face-varying data is refined too (``uv_mode``), seams split as in
+    :func:`hybridsub.subdivide_face_varying`.
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
@@ -42,11 +49,20 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     pairs, sharp = sharp_edges, sharpness
     mask = None
     total = 0.0
+    tags = dict(sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                max_memory=max_memory)
+    if uv is not None:
+        uv = np.ascontiguousarray(uv, dtype=np.float64)
+        face_uv = np.asarray(face_uv, dtype=np.int64)
+        run = subdivide_face_varying_levels(X, F, uv, face_uv, sharp_edges, levels, scheme=scheme, uv_mode=uv_mode,
+                                            **tags)
+    else:
+        run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, **tags)
     t = time.perf_counter()
-    for out in subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
-                                sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                                max_memory=max_memory):
+    for out in run:
         X, F, pairs, sharp, mask = out.X, out.faces, out.sharp_edges, out.sharpness, out.sharp_faces
+        if uv is not None:
+            uv, face_uv = out.UV, out.uv_faces
         parent = parent[out.face_parent]
         dt = time.perf_counter() - t
         total += dt
@@ -62,7 +78,8 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     if sharp is None:
         sharp = np.full(len(pairs), np.inf)
     corners = np.empty(0, np.int64) if corners is None else np.asarray(corners, dtype=np.int64)
-    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total)
+    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total, uv,
+                       face_uv)
 
 
 def _si(x: float) -> str:

@@ -18,7 +18,7 @@ from . import _validate as val
 from ._features import merge_detected
 from ._stencils import apply_matrix, apply_step, step_matrix
 from ._topology import child_creases, child_level, face_parents, plan_step
-from ._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme
+from ._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +41,11 @@ class RefinementStep:
         Corner vertices (the same indices at every level).
     face_parent : (m',) int64
         The face of level k each face of level k + 1 was emitted by.
+    uv_faces : (m', 3) int64 or None
+        With ``refine(..., uv_faces=...)``: the UV index of each corner of ``faces`` (row by
+        row); else None.
+    uv_matrix : scipy.sparse.csr_matrix or None
+        With ``uv_faces``: the step's UV matrix, ``UV_{k+1} = uv_matrix @ UV_k``; else None.
     """
 
     faces: np.ndarray
@@ -50,6 +55,8 @@ class RefinementStep:
     sharp_faces: np.ndarray
     corners: np.ndarray
     face_parent: np.ndarray
+    uv_faces: np.ndarray | None = None
+    uv_matrix: sp.csr_matrix | None = None
 
     @property
     def n_vertices(self) -> int:
@@ -75,6 +82,12 @@ class Refinement:
         Number of vertices of the finest level.
     n_coarse : int
         Number of vertices of the input.
+    uv_faces : (m_L, 3) int64 or None
+        With ``refine(..., uv_faces=FUV)``: the UV index of each corner of ``faces``, row by
+        row (``FUV`` refined); else None.
+    uv_matrix : scipy.sparse.csr_matrix or None
+        With ``uv_faces``: the composite UV matrix (t_L × t), ``UV2 = uv_matrix @ UV``;
+        else None.
     """
 
     faces: np.ndarray
@@ -86,10 +99,20 @@ class Refinement:
     steps: list
     n_coarse: int
     _cache: dict = field(default_factory=dict, repr=False)
+    _uv: Refinement | None = field(default=None, repr=False)  # the UV index mesh's refinement
 
     @property
     def n_vertices(self) -> int:
         return self.steps[-1].n_vertices if self.steps else self.n_coarse
+
+    @property
+    def uv_faces(self) -> np.ndarray | None:
+        return None if self._uv is None else self._uv.faces
+
+    @property
+    def uv_matrix(self) -> sp.csr_matrix | None:
+        """Composite UV matrix ``S_uv,L ⋯ S_uv,1`` (t_L × t), computed once; None without UVs."""
+        return None if self._uv is None else self._uv.matrix
 
     @property
     def matrix(self) -> sp.csr_matrix:
@@ -140,7 +163,8 @@ class Refinement:
 def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *, n_vertices: int | None = None,
            scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
            corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
-           non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None) -> Refinement:
+           non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
+           n_uvs: int | None = None, uv_mode: UVMode = "linear") -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -179,11 +203,25 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
         Refuse (``OutputTooLargeError``) if the refinement is estimated to need more bytes than
         this (e.g. ``8e9``, ``"8G"``, ``"none"``). Default: :func:`hybridsub.set_memory_limit`,
         else the environment variable ``HYBRIDSUB_MAX_MEMORY``, else 80 % of the physical memory.
+    uv_faces : (m, 3) array_like of int, optional
+        Face-varying data (UVs with seams): the UV index of each face corner, row ``f`` for
+        face ``f`` (OBJ's ``f v/vt``). The UV index mesh is refined beside the geometry:
+        ``uv_faces`` and ``uv_matrix`` of the result and of each step. Seams (interior edges
+        whose faces disagree on the UV indices) are split, never flipped, so in ``"hybrid"``
+        the geometry differs from the refinement without ``uv_faces`` along seams;
+        ``"sqrt3"`` raises ``ValueError``. See :func:`hybridsub.refine_face_varying` and
+        ``docs/face_varying.md``.
+    n_uvs : int, optional
+        Number of UV values; default ``uv_faces.max() + 1``.
+    uv_mode : {"linear", "smooth"}
+        With ``uv_faces``: ``"linear"`` (default) interpolates UVs linearly, ``"smooth"``
+        applies the scheme's rules to the UV index mesh (its boundary and seams as creases).
 
     Returns
     -------
     Refinement
-        ``faces``, ``matrix``, tags, ``face_parent``, ``steps`` and ``apply``.
+        ``faces``, ``matrix``, tags, ``face_parent``, ``steps`` and ``apply``; with
+        ``uv_faces`` also ``uv_faces`` and ``uv_matrix``.
 
     Examples
     --------
@@ -192,12 +230,26 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     >>> r = hybridsub.refine(F, levels=2, scheme="sqrt3")
     >>> r.faces.shape, r.matrix.shape
     ((36, 3), (20, 4))
+    >>> FUV = np.arange(12).reshape(4, 3)      # UVs: every face its own chart, every edge a seam
+    >>> r = hybridsub.refine(F, levels=1, uv_faces=FUV)
+    >>> r.faces.shape, r.uv_faces.shape, r.matrix.shape, r.uv_matrix.shape
+    ((24, 3), (24, 3), (14, 4), (28, 12))
     """
     budget = _budget.Budget(val.check_options(scheme, levels, loop_weights), scheme, max_memory)
+    if uv_faces is None and n_uvs is not None:
+        raise ValueError("n_uvs was given without uv_faces")
     if val.check_non_manifold(non_manifold) == "cut":  # cut, refine the cut mesh, compose
         return _repair.refine_cut(refine, F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme,
                                   sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                                  loop_weights=loop_weights, max_memory=max_memory)
+                                  loop_weights=loop_weights, max_memory=max_memory,
+                                  uv=dict(uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode))
+    if uv_faces is not None:  # the face-varying step loop (seams split), in _facevarying
+        from ._facevarying import refine_with_uvs
+
+        return refine_with_uvs(F, uv_faces, sharp_edges, levels, n_vertices=n_vertices, n_uvs=n_uvs, scheme=scheme,
+                               uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
+                               loop_weights=loop_weights, max_memory=max_memory)
+    check_uv_mode(uv_mode)
     levels, Fi, n, pairs, sharp, face_sharp, faces_as_indices, corner = _prepare(
         F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
 
@@ -222,6 +274,15 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
                    last.sharp_faces if last else faces_out(face_sharp), corners_out, face_parent, steps, n)
     r._cache["max_memory"] = max_memory  # the composite matrix honours the same limit
     return r
+
+
+UV_MODES = ("linear", "smooth")
+
+
+def check_uv_mode(uv_mode) -> str:
+    if not isinstance(uv_mode, str) or uv_mode not in UV_MODES:
+        raise ValueError(f"uv_mode must be one of {UV_MODES}, got {uv_mode!r}")
+    return uv_mode
 
 
 def _prepare(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights):

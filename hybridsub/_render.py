@@ -99,7 +99,7 @@ def fit(V: np.ndarray, R: np.ndarray, width: int, height: int, margin: float = 0
 
 def render(V, F, R, width: int, height: int, *, frame=None, lines=None, color=(0.78, 0.80, 0.84),
            line_color=(0.85, 0.05, 0.05), line_width: float = 1.6, background=(1.0, 1.0, 1.0),
-           outline: bool = True) -> np.ndarray:
+           outline: bool = True, texture=None) -> np.ndarray:
     """Render a triangle mesh into an (height, width, 3) uint8 RGB image.
 
     Parameters
@@ -114,6 +114,10 @@ def render(V, F, R, width: int, height: int, *, frame=None, lines=None, color=(0
         hidden, ``line_width`` pixels wide.
     outline : bool
         Darken depth discontinuities (silhouettes), which makes shapes easier to read.
+    texture : (UV, FUV, image), optional
+        Colour each pixel by ``image(uv)`` (a function of (k, 2) UVs returning (k, 3) RGB in
+        [0, 1]) at the UV interpolated over its face, ``UV (t, 2)`` indexed per face corner
+        by ``FUV (m, 3)`` (face-varying), instead of ``color``.
     """
     s = SUPERSAMPLE
     W, H = width * s, height * s
@@ -148,7 +152,15 @@ def render(V, F, R, width: int, height: int, *, frame=None, lines=None, color=(0
     hit = fid >= 0
     img = np.empty((H, W, 3))
     img[:] = background
-    img[hit] = face_rgb[fid[hit]]
+    if texture is None:
+        img[hit] = face_rgb[fid[hit]]
+    else:
+        UV, FUV, image = texture
+        ys, xs = np.nonzero(hit)
+        f = fid[ys, xs]
+        rgb = image(_pixel_uv(P, F, f, xs + 0.5, ys + 0.5, np.asarray(UV, dtype=np.float64), np.asarray(FUV)))
+        tint = np.where(front[:, None], 1.0, np.array([0.85, 0.75, 0.7]))
+        img[ys, xs] = np.clip(rgb * tint[f] * (0.22 + diffuse[f])[:, None] + spec[f][:, None], 0, 1)
     if outline:
         d = np.where(hit, depth, np.nanmin(np.where(hit, depth, np.inf)) - zspan if hit.any() else 0)
         jump = 0.02 * zspan
@@ -168,6 +180,18 @@ def render(V, F, R, width: int, height: int, *, frame=None, lines=None, color=(0
         img = img * (1 - mask[..., None]) + np.asarray(rgb) * mask[..., None]
     img = img.reshape(height, s, width, s, 3).mean(axis=(1, 3))
     return np.clip(np.round(img * 255), 0, 255).astype(np.uint8)
+
+
+def _pixel_uv(P, F, f, px, py, UV, FUV) -> np.ndarray:
+    """UV at screen points (px, py) inside faces f: barycentric interpolation (the projection
+    is orthographic, so screen barycentrics are the surface's)."""
+    a, b, c = (P[F[f, k]] for k in range(3))
+    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    w0 = ((b[:, 0] - px) * (c[:, 1] - py) - (c[:, 0] - px) * (b[:, 1] - py)) / area
+    w1 = ((c[:, 0] - px) * (a[:, 1] - py) - (a[:, 0] - px) * (c[:, 1] - py)) / area
+    w2 = 1.0 - w0 - w1
+    T = UV[FUV[f]]
+    return w0[:, None] * T[:, 0] + w1[:, None] * T[:, 1] + w2[:, None] * T[:, 2]
 
 
 def choose_view(V, F, lines=None, candidates=None) -> tuple[float, float]:

@@ -193,8 +193,12 @@ def map_sharp_edges(cut: Cut, F: np.ndarray, pairs: np.ndarray, sharp: np.ndarra
 
 
 def refine_cut(refine, F, sharp_edges, levels, *, n_vertices, scheme, sharpness, sharp_faces, corners,
-               loop_weights, max_memory):
-    """``refine`` with ``non_manifold="cut"``: cut, refine the cut mesh, compose with the duplication."""
+               loop_weights, max_memory, uv):
+    """``refine`` with ``non_manifold="cut"``: cut, refine the cut mesh, compose with the duplication.
+
+    ``uv`` (``uv_faces``, ``n_uvs``, ``uv_mode``) goes to ``refine`` unchanged: the cut keeps
+    the faces and their order, so the UV index mesh is the caller's.
+    """
     Fi, n = val.as_faces(F, n_vertices)
     pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
     corner_in = val.as_corner_mask(corners, n)
@@ -205,7 +209,7 @@ def refine_cut(refine, F, sharp_edges, levels, *, n_vertices, scheme, sharpness,
     creased[pairs[sharp > 0].ravel()] = True
     cut = cut_non_manifold(Fi, n, creased)
     common = dict(scheme=scheme, sharp_faces=sharp_faces, loop_weights=loop_weights, max_memory=max_memory,
-                  non_manifold="raise")
+                  non_manifold="raise", **uv)
     if cut is None:  # nothing to cut: exactly the plain refinement
         return refine(Fi, sharp_edges, levels, n_vertices=n, sharpness=sharpness, corners=corners, **common)
     cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)

@@ -24,7 +24,7 @@ def check_options(scheme, levels, loop_weights) -> int:
         raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
     if loop_weights not in R.LOOP_WEIGHTS:
         raise ValueError(f"loop_weights must be one of {R.LOOP_WEIGHTS}, got {loop_weights!r}")
-    return _count(levels, "levels")
+    return count(levels, "levels")
 
 
 NON_MANIFOLD = ("raise", "cut")
@@ -36,7 +36,7 @@ def check_non_manifold(non_manifold) -> str:
     return non_manifold
 
 
-def _count(x, name: str) -> int:
+def count(x, name: str) -> int:
     """A non-negative int option (n_vertices)."""
     if isinstance(x, (bool, np.bool_)):
         raise TypeError(f"{name} must be a non-negative integer, got {x!r}")
@@ -49,7 +49,7 @@ def _count(x, name: str) -> int:
     return x
 
 
-def _array(x, name: str, width: int, row: str, rows: str = "k") -> np.ndarray:
+def as_array(x, name: str, width: int, row: str, rows: str = "k") -> np.ndarray:
     """np.asarray, with numpy's errors on ragged or odd input turned into ones that say what is wrong."""
     try:
         return np.asarray(x)
@@ -79,7 +79,7 @@ def as_vertices(V, return_dtype: bool = False):
 
     With ``return_dtype``, also the dtype results should take: V's if floating, else float64.
     """
-    A = _array(V, "V", 3, "vertex", "n")
+    A = as_array(V, "V", 3, "vertex", "n")
     if A.ndim == 1 and A.size == 0:
         A = A.reshape(0, 3)
     if A.dtype == object or not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
@@ -99,7 +99,7 @@ def as_vertices(V, return_dtype: bool = False):
 
 def as_data(X, n: int):
     """Per-vertex data for ``Refinement.apply``: (array, dtype of the result, dtype to compute in)."""
-    A = _array(X, "data", 0, "row")
+    A = as_array(X, "data", 0, "row")
     if A.ndim == 0 or A.shape[0] != n:
         raise MeshError(f"data must have one row per coarse vertex ({n}), got shape {A.shape}")
     if np.issubdtype(A.dtype, np.complexfloating):
@@ -111,7 +111,7 @@ def as_data(X, n: int):
     raise TypeError(f"data must be numeric, got dtype {A.dtype}")
 
 
-def _integral(A: np.ndarray) -> np.ndarray:
+def not_integral(A: np.ndarray) -> np.ndarray:
     """Rows of a float array that do not hold integers (NaN and inf included)."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(A) | (A != np.round(A))
@@ -121,8 +121,8 @@ def _integral(A: np.ndarray) -> np.ndarray:
 def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
     """(m, 3) int64 C-contiguous faces, checked; returns (faces, n_vertices)."""
     if n_vertices is not None:
-        n_vertices = _count(n_vertices, "n_vertices")
-    A = _array(F, "F", 3, "face", "m")
+        n_vertices = count(n_vertices, "n_vertices")
+    A = as_array(F, "F", 3, "face", "m")
     if A.ndim == 1 and A.size == 0:
         A = A.reshape(0, 3)
     if A.dtype == bool:
@@ -133,7 +133,7 @@ def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
         hint = _TRIANGULATE if A.ndim == 2 and A.shape[1] > 3 else ""
         raise MeshError(f"F must have shape (m, 3), got {A.shape}{hint}")
     if np.issubdtype(A.dtype, np.floating) and A.size:
-        frac = _integral(A)
+        frac = not_integral(A)
         if frac.any():
             f = int(np.flatnonzero(frac)[0])
             raise MeshError(f"F must hold integer vertex indices; face {f} is {A[f].tolist()}")
@@ -174,7 +174,7 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
         if sharpness is not None and np.size(sharpness):
             raise ValueError("sharpness was given without sharp_edges")
         return np.empty((0, 2), np.int64), np.empty(0)
-    E = _array(sharp_edges, "sharp_edges", 2, "row")
+    E = as_array(sharp_edges, "sharp_edges", 2, "row")
     if E.size == 0:
         E = E.reshape(0, 2)
     if E.dtype == bool or not (np.issubdtype(E.dtype, np.integer) or np.issubdtype(E.dtype, np.floating)):
@@ -182,7 +182,7 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
     if E.ndim != 2 or E.shape[1] != 2:
         raise MeshError(f"sharp_edges must have shape (k, 2) (vertex pairs), got {E.shape}")
     if np.issubdtype(E.dtype, np.floating) and E.size:
-        frac = _integral(E)
+        frac = not_integral(E)
         if frac.any():
             j = int(np.flatnonzero(frac)[0])
             raise MeshError(f"sharp_edges must hold integer vertex indices; sharp edge {j} is {E[j].tolist()}")
@@ -197,7 +197,7 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
     if sharpness is None:
         s = np.full(len(E), np.inf)
     else:
-        S = _array(sharpness, "sharpness", 1, "entry")
+        S = as_array(sharpness, "sharpness", 1, "entry")
         if S.dtype == bool or not (np.issubdtype(S.dtype, np.integer) or np.issubdtype(S.dtype, np.floating)):
             raise TypeError(f"sharpness must be real numbers (inf: infinitely sharp), got dtype {S.dtype}")
         s = np.array(S, dtype=np.float64).reshape(-1)
@@ -223,7 +223,7 @@ def as_face_mask(sharp_faces, n_faces: int) -> tuple[np.ndarray, bool]:
     """Boolean (m,) mask, and whether the caller gave indices (True) or a mask (False)."""
     if sharp_faces is None:
         return np.zeros(n_faces, dtype=bool), False
-    A = _array(sharp_faces, "sharp_faces", 1, "entry")
+    A = as_array(sharp_faces, "sharp_faces", 1, "entry")
     if A.dtype == bool:
         if A.shape != (n_faces,):
             raise MeshError(
@@ -240,7 +240,7 @@ def as_corner_mask(corners, n_vertices: int) -> np.ndarray:
     mask = np.zeros(n_vertices, dtype=bool)
     if corners is None:
         return mask
-    A = _array(corners, "corners", 1, "entry")
+    A = as_array(corners, "corners", 1, "entry")
     if A.dtype == bool:
         if A.shape != (n_vertices,):
             raise MeshError(
@@ -260,7 +260,7 @@ def _indices(A, n: int, name: str, what: str) -> np.ndarray:
     if not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
         raise TypeError(f"{name} must hold integer {what} indices (or be a boolean mask), got dtype {A.dtype}")
     if np.issubdtype(A.dtype, np.floating):
-        frac = _integral(A)
+        frac = not_integral(A)
         if frac.any():
             j = int(np.flatnonzero(frac)[0])
             raise MeshError(f"{name} must hold integer {what} indices; {name}[{j}] is {A[j]}")

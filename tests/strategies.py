@@ -597,6 +597,67 @@ def tagged_meshes(draw, kind="any", *, sharpness="maybe", sharp_faces=True, corn
     return V, F, tags
 
 
+# ------------------------------- UV charts ----------------------------------------------
+
+
+def twins_of(F):
+    """(3m,) twin halfedge of each halfedge (-1 on the boundary), by sorting (no hybridsub)."""
+    H = halfedges_of(F)
+    n = int(H.max()) + 1 if len(H) else 1
+    key = H[:, 0] * n + H[:, 1]
+    order = np.argsort(key)
+    want = H[:, 1] * n + H[:, 0]
+    pos = np.minimum(np.searchsorted(key[order], want), max(len(key) - 1, 0))
+    found = key[order][pos] == want if len(key) else np.zeros(0, bool)
+    return np.where(found, order[pos], -1)
+
+
+def sectors(F, cut):
+    """Label of each face corner ``3f + i``: corners of one vertex joined across the interior
+    halfedges not in ``cut`` (a (3m,) mask, symmetric over twins)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = len(F)
+    twin = twins_of(F)
+    h = np.flatnonzero((twin >= 0) & ~cut)
+    g = twin[h]
+    nxt = lambda x: x - x % 3 + (x % 3 + 1) % 3  # noqa: E731
+    # h = a->b in face f, g = b->a: a's corners are h and next(g), b's are next(h) and g
+    a = np.concatenate([h, nxt(h)])
+    b = np.concatenate([nxt(g), g])
+    graph = coo_matrix((np.ones(len(a), np.int8), (a, b)), shape=(3 * m, 3 * m))
+    return connected_components(graph, directed=False)[1]
+
+
+@st.composite
+def uv_charts(draw, F, *, max_fraction=0.6, unmapped=None):
+    """Random UV charts on a mesh ``F``: ``(UV (t, 2), FUV (m, 3))``, one UV index per
+    (vertex, face sector), sectors cut along a random subset of the interior edges (the
+    seams), UV indices in random order, a few unused UV values, random UV values. With
+    ``unmapped`` (drawn if None) a few faces have all three corners on one extra UV index, as
+    files map untextured faces (degenerate UV faces, a UV index on several vertices)."""
+    F = np.asarray(F, dtype=np.int64)
+    rng = draw(rngs())
+    twin = twins_of(F)
+    frac = draw(st.sampled_from([0.0, 0.1, 0.3, max_fraction, 1.0]))
+    h = np.flatnonzero((twin >= 0) & (np.arange(len(twin)) < twin))
+    pick = h[rng.random(len(h)) < frac]
+    cut = np.zeros(len(twin), bool)
+    cut[pick] = True
+    cut[twin[pick]] = True
+    _, label = np.unique(sectors(F, cut), return_inverse=True)
+    t = int(label.max()) + 1 if len(label) else 0
+    extra = draw(st.integers(0, 2))
+    perm = rng.permutation(t + extra)[:t]
+    FUV = perm[label.ravel()].reshape(-1, 3).astype(np.int64)
+    unmapped = draw(st.booleans()) if unmapped is None else unmapped
+    if unmapped and len(F) >= 2:
+        FUV[rng.choice(len(F), size=rng.integers(1, len(F) // 4 + 2), replace=False)] = t + extra
+        extra += 1
+    return rng.random((t + extra, 2)), FUV
+
+
 # ------------------------------- broken meshes ------------------------------------------
 #
 # Each strategy below returns a ``Broken`` case: arguments for ``hybridsub.subdivide`` that

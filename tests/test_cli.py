@@ -404,3 +404,95 @@ def test_renderer_hides_what_is_behind():
     swapped[4:, 2] = -0.5  # put the second square behind: now the line shows there too
     img = render(swapped, F, view_rotation(0, 0), 120, 80, outline=False, lines=np.array([[0, 2]]))
     assert red(33, 60)
+
+
+def test_renderer_draws_a_texture_from_face_varying_uvs():
+    """A square facing the camera, two triangles with their own UV indices (a seam on the
+    diagonal, the UVs continuous across it): a 2 × 2 checkerboard lands in the four quarters."""
+    from hybridsub._render import render, view_rotation
+
+    V = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    UV = np.array([[0, 0], [1, 0], [1, 1], [0, 0], [1, 1], [0, 1]], float)
+    FUV = np.array([[0, 1, 2], [3, 4, 5]])
+
+    def image(uv):
+        odd = (np.floor(uv[:, 0] * 2) + np.floor(uv[:, 1] * 2)) % 2 == 1
+        return np.where(odd[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+
+    img = render(V, F, view_rotation(0, 0), 100, 100, outline=False, texture=(UV, FUV, image)).astype(int)
+    blue = lambda y, x: img[y, x, 2] > 2 * img[y, x, 0]  # noqa: E731
+    assert not blue(70, 30) and blue(70, 70) and blue(30, 30) and not blue(30, 70)  # (u, v) = image (x, up)
+    assert (img[2, 2] == 255).all()
+
+
+# ----------------------------------------------------------------------------------------------
+# textured OBJ: vt and f v/vt, seams refined face-varying
+
+def _textured_bunny(tmp_path):
+    d = np.load(os.path.join(DATA, "bunny10k_textured.fvar_linear.L1.npz"))
+    V, F, UV, FUV = d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"]
+    path = tmp_path / "bunny.obj"
+    hybridsub.write_mesh(path, V, F, uv=UV, face_uv=FUV)
+    return str(path), V, F, UV, FUV
+
+
+def test_textured_obj_round_trips(tmp_path, capsys):
+    """vt and f v/vt in, seams refined face-varying, vt and f v/vt out: what
+    subdivide_face_varying gives, to the bit (OBJ floats are written as repr)."""
+    path, V, F, UV, FUV = _textured_bunny(tmp_path)
+    out = tmp_path / "b2.obj"
+    r = run("subdivide", path, "-o", out, "--levels", 2)
+    assert r.returncode == 0, r.stderr
+    assert "dropped" not in r.stderr
+    m = read_mesh(out)
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2)
+    assert np.array_equal(m.vertices, V2) and np.array_equal(m.faces, F2)
+    assert np.array_equal(m.uv, UV2) and np.array_equal(m.face_uv, FUV2)
+    # smooth UVs with Loop; one level, then one more from the written file, is two levels
+    for k, target in ((1, "s1.obj"), (2, "s2.obj")):
+        assert main(["subdivide", path, "-o", str(tmp_path / target), "--levels", str(k), "--scheme", "loop",
+                     "--uv-mode", "smooth", "-q"]) == 0
+    assert main(["subdivide", str(tmp_path / "s1.obj"), "-o", str(tmp_path / "s11.obj"), "--levels", "1",
+                 "--scheme", "loop", "--uv-mode", "smooth", "-q"]) == 0
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, scheme="loop", uv_mode="smooth")
+    for name in ("s2.obj", "s11.obj"):
+        m = read_mesh(tmp_path / name)
+        assert np.array_equal(m.faces, F2) and np.array_equal(m.face_uv, FUV2), name
+        assert np.allclose(m.vertices, V2, atol=1e-13, rtol=0) and np.allclose(m.uv, UV2, atol=1e-13, rtol=0)
+    assert np.array_equal(read_mesh(tmp_path / "s2.obj").uv, UV2)  # one run: to the bit
+    assert capsys.readouterr().err == ""
+
+
+def test_textured_obj_with_sqrt3_and_other_formats(tmp_path, capsys):
+    path, V, F, UV, FUV = _textured_bunny(tmp_path)
+    assert main(["subdivide", path, "-o", str(tmp_path / "k.obj"), "--levels", "1", "--scheme", "sqrt3"]) == 0
+    err = capsys.readouterr().err
+    assert "note: texture coordinates dropped: Kobbelt's √3 cannot keep UV seams (use --scheme hybrid" in err
+    m = read_mesh(tmp_path / "k.obj")
+    assert m.uv is None and len(m.faces) == 3 * len(F)
+    assert main(["subdivide", path, "-o", str(tmp_path / "k.obj"), "--scheme", "sqrt3", "--uv-mode", "smooth"]) == 1
+    assert "--uv-mode needs --scheme hybrid or loop" in capsys.readouterr().err
+    # PLY keeps the seams as per-face texcoords (float32)
+    assert main(["subdivide", path, "-o", str(tmp_path / "b.ply"), "--levels", "1", "-q"]) == 0
+    m = read_mesh(tmp_path / "b.ply")
+    V1, F1, UV1, FUV1 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=1)
+    assert np.array_equal(m.faces, F1) and np.allclose(m.uv[m.face_uv], UV1[FUV1], atol=1e-6, rtol=0)
+
+
+def test_textured_counts_are_predicted():
+    """The counts info and the progress bar use include the split seams: exact with UVs, and
+    without them (compare) the plain refinement's."""
+    from hybridsub._cli import Features, _predict
+
+    d = np.load(os.path.join(DATA, "bunny10k_textured.fvar_linear.L1.npz"))
+    m = hybridsub.TaggedMesh(d["V_in"], d["F_in"], uv=d["UV_in"], face_uv=d["FUV_in"])
+    none = Features(np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64), np.empty(0, np.int64), "")
+    for scheme in ("hybrid", "loop"):
+        r = hybridsub.refine(d["F_in"], levels=3, scheme=scheme, uv_faces=d["FUV_in"])
+        pred = _predict(m, 3, scheme, none)
+        assert [(p["faces"], p["vertices"]) for p in pred] == [(len(s.faces), s.n_vertices) for s in r.steps]
+    plain = _predict(m, 3, "hybrid", none, uv=False)
+    r = hybridsub.refine(d["F_in"], levels=3)
+    assert [(p["faces"], p["vertices"]) for p in plain] == [(len(s.faces), s.n_vertices) for s in r.steps]
+    assert plain[-1]["faces"] < _predict(m, 3, "hybrid", none)[-1]["faces"]

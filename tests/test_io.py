@@ -120,6 +120,16 @@ t interpolateboundary 1/0/0 2
     assert len(F2) == 48
 
 
+def test_obj_vt_with_one_or_three_numbers(tmp_path):
+    """'vt u' means v = 0; 'vt u v w' keeps u and v (both OBJ forms exist in the wild)."""
+    head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+    for vt, want in (("vt 0.5\nvt 0.25\nvt 1\n", [[0.5, 0], [0.25, 0], [1, 0]]),
+                     ("vt 0.5 0.1 0.3\nvt 0.25 0.2 0\nvt 1 0.1 0.3\n", [[0.5, 0.1], [0.25, 0.2], [1, 0.1]]),
+                     ("vt 0.5\nvt 0.25 0.2\nvt 1 0.1 0.3\n", [[0.5, 0], [0.25, 0.2], [1, 0.1]])):
+        m = read_mesh(_write(tmp_path / "t.obj", head + vt + "f 1/1 2/2 3/3\n"))
+        assert m.uv.tolist() == want and m.face_uv.tolist() == [[0, 1, 2]]
+
+
 def test_tag_variants(tmp_path):
     text = """v 0 0 0
 v 1 0 0
@@ -308,3 +318,32 @@ def test_opensubdiv_reference_through_a_file(tmp_path):
     m = read_mesh(tmp_path / "c.obj")
     V, F = hybridsub.subdivide(m.vertices, m.faces, m.sharp_edges, 2, scheme="loop", sharpness=m.sharpness)
     assert mesh_difference(V, F, d["V"], d["F"], 1e-9) is None
+
+
+def test_textured_glb_keeps_its_seams(tmp_path):
+    """glTF holds UVs per vertex: writing duplicates vertices along seams, reading welds them
+    back (a TaggedMesh holds face-varying UVs), so the surface is one piece again."""
+    d = np.load(os.path.join(DATA, "bunny10k_textured.fvar_linear.L1.npz"))
+    V, F, UV, FUV = d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"]
+    write_mesh(tmp_path / "b.glb", V, F, uv=UV, face_uv=FUV)
+    import trimesh
+
+    t = trimesh.load(tmp_path / "b.glb", process=False, force="mesh")
+    assert len(t.vertices) == len(UV) and t.visual.uv.shape == (len(UV), 2)  # one vertex per (v, vt) pair
+    m = read_mesh(tmp_path / "b.glb")
+    assert len(m.vertices) == len(V) and np.array_equal(m.faces.shape, F.shape)
+    assert any("welded 1400 vertices that the file duplicates along UV seams" in n for n in m.notes)
+    assert np.allclose(m.vertices[m.faces], V[F], atol=1e-5) and np.allclose(m.uv[m.face_uv], UV[FUV], atol=1e-6)
+    assert len(hybridsub.seam_edges(m.faces, m.face_uv)) == len(hybridsub.seam_edges(F, FUV))
+
+
+def test_weld_merges_equal_uv_copies():
+    """--weld: UV indices that land on one vertex with equal UVs become one (no seam there)."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    F = np.array([[0, 1, 2], [3, 4, 5]])
+    uv = V[:, :2].copy()
+    m, merged, _ = _io.weld(_io.TaggedMesh(V, F, uv=uv, face_uv=F.copy()))
+    assert merged == 2 and m.face_uv.tolist() == [[0, 1, 2], [1, 3, 2]] and len(m.uv) == 4
+    uv[3] += 0.5  # a real seam at vertex 1 now: two UV indices there
+    m, _, _ = _io.weld(_io.TaggedMesh(V, F, uv=uv, face_uv=F.copy()))
+    assert m.face_uv.tolist() == [[0, 1, 2], [3, 4, 2]] and len(hybridsub.seam_edges(m.faces, m.face_uv)) == 1

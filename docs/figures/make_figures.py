@@ -1,4 +1,5 @@
-"""Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md and docs/semisharp.md.
+"""Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md, docs/semisharp.md
+and docs/face_varying.md.
 
 usage: python docs/figures/make_figures.py [--out DIR] [--quick]
 
@@ -338,13 +339,66 @@ def fig_semisharp(out, quick):
         os.path.join(out, "semisharp_cube.png"), optimize=True)
 
 
+def _checkerboard(squares):
+    """A texture: ``squares`` × ``squares`` checkerboard over the unit UV square."""
+    light, dark = np.array([0.95, 0.93, 0.88]), np.array([0.18, 0.33, 0.6])
+
+    def image(uv):
+        odd = (np.floor(uv[:, 0] * squares) + np.floor(uv[:, 1] * squares)) % 2 == 1
+        return np.where(odd[:, None], dark, light)
+
+    return image
+
+
+def fig_textured(out, quick):
+    """The textured bunny (OpenSubdiv's test scan, 1,289 UV seams), its texture drawn as a
+    checkerboard from the UVs: input; two hybrid levels with linear and smooth UVs (welded,
+    face-varying); two levels of the mesh as trimesh stores it (vertices split along the
+    seams, not welded). Bottom row: a close-up of a seam on the back."""
+    import trimesh
+
+    from hybridsub import _render
+
+    d = np.load(os.path.join(HERE, "..", "..", "tests", "data", "bunny10k_textured.fvar_linear.L1.npz"))
+    V, F, UV, FUV = d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"]
+    n_seams = len(hybridsub.seam_edges(F, FUV))
+    panels = [(f"input: {len(F):,} faces,\n{n_seams:,} UV seams", V, F, UV, FUV)]
+    for mode in ("linear", "smooth"):
+        V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, uv_mode=mode)
+        panels.append((f'hybrid, 2 levels, uv_mode="{mode}"\n{len(F2):,} faces', V2, F2, UV2, FUV2))
+    vertex_of_uv = np.empty(len(UV), np.int64)
+    vertex_of_uv[FUV.ravel()] = F.ravel()
+    split = trimesh.Trimesh(V[vertex_of_uv], FUV, visual=trimesh.visual.TextureVisuals(uv=UV), process=False)
+    apart = hybridsub.subdivide_mesh(split, 2, weld=False)
+    panels.append(("not welded: seams refined as open\nboundaries (creases, cracks)", apart.vertices, apart.faces,
+                   apart.visual.uv, apart.faces))
+    size = 220 if quick else 330
+    R = _render.view_rotation(0, 10)
+    center = (V.min(axis=0) + V.max(axis=0)) / 2
+    scale, mid, zspan = _render.fit(V - center, R, size, size)
+    zoom, spot = 4.5, np.array([2.0, 0.6])  # the close-up: 4.5 times, on the seam across the back
+    image = _checkerboard(24)
+    fig, axs = plt.subplots(2, 4, figsize=(4 * size / 100, 2 * size / 100 + 0.75))
+    for j, (title, A, B, U, T) in enumerate(panels):
+        for i, frame in enumerate([(scale, mid, zspan), (scale * zoom, spot, zspan)]):
+            axs[i, j].imshow(_render.render(A - center, B, R, size, size, frame=frame, texture=(U, T, image)))
+            axs[i, j].set_axis_off()
+        axs[0, j].set_title(title, fontsize=9)
+        x = (spot[0] - mid[0]) * scale + size / 2
+        y = size / 2 - (spot[1] - mid[1]) * scale
+        h = size / zoom / 2
+        axs[0, j].add_patch(plt.Rectangle((x - h, y - h), 2 * h, 2 * h, fill=False, color="tab:red", lw=1))
+    fig.tight_layout(pad=0.3)
+    _save(fig, os.path.join(out, "textured_bunny.png"), 100)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=HERE)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp):
+    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp, fig_textured):
         t = time.time()
         f(args.out, args.quick)
         print(f"{f.__name__}: {time.time() - t:.1f} s", file=sys.stderr)
