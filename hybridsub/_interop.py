@@ -11,7 +11,7 @@ from ._io import classes
 from ._errors import MeshError
 from ._features import detect_features
 from ._refine import Refinement, refine
-from ._typing import ArrayLike, LoopWeights, Scheme, UVMode
+from ._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -24,7 +24,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
                    sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
                    sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                    feature_angle: float | None = None, loop_weights: LoopWeights = "loop",
-                   weld: bool | None = None, uv_mode: UVMode = "linear") -> trimesh.Trimesh:
+                   weld: bool | None = None, uv_mode: UVMode = "linear",
+                   non_manifold: NonManifold = "raise") -> trimesh.Trimesh:
     """Subdivide a ``trimesh.Trimesh``, carrying its attributes and features along.
 
     Per-vertex data — colours, every array in ``mesh.vertex_attributes`` — is refined by the
@@ -73,6 +74,10 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
         are joined there (a bow-tie, refined as a corner); parts that share an edge or a face
         make the welded mesh invalid, which raises ``MeshError`` — pass ``weld=False`` for
         such a mesh.
+    non_manifold : {"raise", "cut"}
+        As in :func:`hybridsub.refine`: ``"raise"`` (default) refuses edges in three or more
+        faces and inconsistently oriented ones, naming the edge; ``"cut"`` cuts the mesh along
+        them (they become creases) and refines the pieces.
     uv_mode : {"linear", "smooth"}
         With a welded mesh: how UVs (and per-corner data) are refined, as in
         :func:`hybridsub.subdivide_face_varying`. ``"linear"`` (default) never distorts the
@@ -162,7 +167,7 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
         r = refine(w.F, edges_w, levels, n_vertices=len(w.V), scheme=scheme, sharpness=sharp_w,
                    sharp_faces=sharp_faces, corners=corners_w, loop_weights=loop_weights,
                    uv_faces=w.FUV if w.face_varying else None, uv_mode=uv_mode,
-                   n_uvs=w.n_corners if w.face_varying else None)
+                   n_uvs=w.n_corners if w.face_varying else None, non_manifold=non_manifold)
     except MeshError as e:
         if not w.welded:
             raise

@@ -132,8 +132,22 @@ def test_errors(cube):
     with pytest.raises(TypeError, match="trimesh.Trimesh"):
         hybridsub.subdivide_mesh(trimesh.Scene(), 1)
     bad = trimesh.Trimesh(np.r_[V, [[9, 9, 9]]], np.r_[F, [[0, 1, len(V)]]], process=False)
-    with pytest.raises(hybridsub.MeshError, match="shared by 3 faces"):
+    with pytest.raises(hybridsub.MeshError, match="shared by 3 faces.*non_manifold=\"cut\""):
         hybridsub.subdivide_mesh(bad, 1)
+
+
+def test_non_manifold_cut_is_refine_with_cut(cube):
+    """The hint of the error above works here too: non_manifold="cut" refines the cut mesh,
+    with the caller's vertices and their colours."""
+    V, F, _ = cube
+    V3, F3 = np.r_[V, [[9, 9, 9]]], np.r_[F, [[0, 1, len(V)]]]
+    bad = trimesh.Trimesh(V3, F3, process=False)
+    bad.visual.vertex_colors = np.tile([10, 200, 30, 255], (len(V3), 1))
+    fine = hybridsub.subdivide_mesh(bad, 2, non_manifold="cut")
+    r = hybridsub.refine(F3, None, 2, n_vertices=len(V3), non_manifold="cut")
+    np.testing.assert_array_equal(fine.faces, r.faces)
+    assert np.array_equal(fine.vertices, r.apply(V3))
+    assert (fine.visual.vertex_colors == [10, 200, 30, 255]).all()
 
 
 # ----------------------------------------------------------------------------------------------
