@@ -320,7 +320,7 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangu
         notes.append("texture coordinates dropped: some faces have none")
     if origin is not None:
         notes.append(f"triangulated {len(faces)} polygons into {len(F)} triangles")
-    _check_range(path, F, len(V), "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, len(V), "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     if face_uv is not None and uv is not None:
         _check_range(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}")
     edges, sharpness, corners, sharp_faces, tag_notes, boundary_corners = _parse_tags(path, tags, len(V), len(faces))
@@ -466,7 +466,7 @@ def _read_off(path: str, triangulate: bool) -> TaggedMesh:
         if colors.max(initial=0) > 1:
             colors = colors / 255.0
     F, origin = _polygons(path, polys, triangulate)
-    _check_range(path, F, nv, "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, nv, "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     notes = (f"triangulated {nf} polygons into {len(F)} triangles",) if origin is not None else ()
     return TaggedMesh(V, F, vertex_colors=colors, notes=notes)
 
@@ -495,7 +495,7 @@ def _read_ply(path: str, triangulate: bool) -> TaggedMesh:
         F, origin = polys.astype(np.int64), None
     else:
         F, origin = _polygons(path, [list(map(int, p)) for p in polys], triangulate)
-    _check_range(path, F, n, "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, n, "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     uv = face_uv = None
     names = next(((a, b) for a, b in (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
                   if a in vd and b in vd), None)
