@@ -192,13 +192,18 @@ def _ram_bytes() -> int | None:
 
 
 def _check_memory(a, pred: list[dict], what: str) -> None:
+    """Refuse a run whose estimated peak exceeds 80% of the memory at hand: the machine's RAM, or
+    ``a.memory_limit`` (bytes) where the caller has less (a batch task: its Dask worker's limit)."""
     if not pred:
         return
     peak = max(p["peak_bytes"] for p in pred)
-    ram = _ram_bytes()
+    ram, owner = _ram_bytes(), "this machine has"
+    limit = getattr(a, "memory_limit", None)
+    if limit and (not ram or limit < ram):
+        ram, owner = limit, "the Dask worker's memory limit is"
     if ram and peak > 0.8 * ram and not a.force:
         raise CLIError(f"{what} would need about {_bytes(peak)} of memory at level {len(pred)} "
-                       f"({pred[-1]['faces']:,} faces); this machine has {_bytes(ram)}. Use fewer levels, "
+                       f"({pred[-1]['faces']:,} faces); {owner} {_bytes(ram)}. Use fewer levels, "
                        "or --force to try anyway")
 
 
@@ -221,28 +226,52 @@ def _predict(mesh: TaggedMesh, levels: int, scheme: str, feat: Features, attribu
 
 
 def cmd_subdivide(a) -> int:
-    mesh = _load(a, a.input)
-    out_ext = os.path.splitext(a.output)[1].lower()
-    if not out_ext:
-        raise CLIError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .stl, .glb, …)")
-    feat = gather_features(a, mesh, a.input, a.scheme)
+    if not os.path.splitext(a.output)[1]:
+        raise CLIError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .npz, .stl, .glb, …)")
+    subdivide_file(a, a.input, a.output)
+    return 0
+
+
+@dataclass
+class FileResult:
+    """What :func:`subdivide_file` made, for the batch manifest."""
+    faces_in: int
+    faces_out: int
+    vertices_out: int
+    features: str  # the feature summary, as the command prints it
+    notes: list[str]  # what the reader did (from TaggedMesh.notes)
+    seconds_read: float
+    seconds_refine: float
+    seconds_write: float
+
+
+def subdivide_file(a, src: str, dst: str, write_to: str | None = None) -> FileResult:
+    """``hybridsub subdivide SRC -o DST`` with the options in ``a``: read, gather the features,
+    refine, write. ``write_to`` is the file actually written (the batch's temporary name, with
+    DST's extension); messages name DST."""
+    t0 = time.perf_counter()
+    mesh = _load(a, src)
+    feat = gather_features(a, mesh, src, a.scheme)
+    t_read = time.perf_counter() - t0
     _say(a, feat.summary)
-    out, seconds = _subdivide(a, mesh, feat, a.levels, a.scheme, a.input)
+    out, seconds = _subdivide(a, mesh, feat, a.levels, a.scheme, src)
     rate = f" ({_rate(len(out.faces) / seconds)} faces/s)" if seconds > 0 and a.levels else ""
     _say(a, f"{SCHEME_NAMES[a.scheme]}, {_n(a.levels, 'level')}: {len(mesh.faces):,} → {len(out.faces):,} faces, "
             f"{len(out.vertices):,} vertices in {seconds:.2f} s{rate}")
     if a.no_tags:
         out = TaggedMesh(out.vertices, out.faces, vertex_colors=out.vertex_colors, uv=out.uv, face_uv=out.face_uv)
     t = time.perf_counter()
-    dropped = _io.write(a.output, out, binary=not a.ascii)
+    dropped = _io.write(write_to or dst, out, binary=not a.ascii)
     dt = time.perf_counter() - t
     kept = _io.describe_tags(out)
     if dropped:
-        _say(a, f"wrote {a.output} in {dt:.2f} s — {out_ext} files cannot hold the {dropped}; "
+        _say(a, f"wrote {dst} in {dt:.2f} s — {os.path.splitext(dst)[1].lower()} files cannot hold the {dropped}; "
                 "write .obj or .ply to keep them")
     else:
-        _say(a, f"wrote {a.output} in {dt:.2f} s" + (f" with its {kept}" if kept else ""))
-    return 0
+        _say(a, f"wrote {dst} in {dt:.2f} s" + (f" with its {kept}" if kept else ""))
+    summary = feat.summary.removeprefix("features: ")
+    return FileResult(len(mesh.faces), len(out.faces), len(out.vertices), summary, list(mesh.notes), t_read,
+                      seconds, dt)
 
 
 def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, path: str):
