@@ -1,4 +1,4 @@
-"""Command line: ``hybridsub subdivide | compare | info | demo``.
+"""Command line: ``hybridsub subdivide | batch | compare | info | demo``.
 
 Messages go to stderr (``--quiet`` silences all but errors), ``info`` writes its report to
 stdout. Exit codes: 0 success, 1 the input or the run failed (one line naming the problem),
@@ -316,6 +316,26 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     return out, res.seconds
 
 
+def cmd_batch(a) -> int:
+    import logging
+
+    from ._batch import batch
+
+    # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    try:
+        s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
+                  format=a.format, loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate,
+                  weld=a.weld, force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
+                  progress=not a.quiet and sys.stderr.isatty())
+    except RuntimeError as e:
+        raise CLIError(str(e)) from None
+    lines = s.failure_lines() if a.quiet else [s.table()]
+    if lines:
+        print("\n".join(lines), file=sys.stderr)
+    return 0 if s.ok else 1
+
+
 def cmd_compare(a) -> int:
     from ._figure import compare_panels, render_figure
 
@@ -493,16 +513,28 @@ def _angle(text: str) -> float:
     return x
 
 
-def _tag_options(p, *, scheme=True, input_opts=True) -> None:
+def _positive(text: str) -> int:
+    try:
+        k = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
+    if k < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {k}")
+    return k
+
+
+def _tag_options(p, *, scheme=True, input_opts=True, tag_files=True) -> None:
     if scheme:
         p.add_argument("--scheme", choices=SCHEMES, default="hybrid",
                        help="hybrid (default): √3 on smooth faces, Loop on sharp ones; sqrt3: Kobbelt; loop")
     g = p.add_argument_group("features (merged when several are given)")
     g.add_argument("--feature-angle", type=_angle, metavar="DEG",
                    help="tag edges whose dihedral angle exceeds DEG degrees as creases")
-    g.add_argument("--sharp-edges", metavar="FILE", help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
-    g.add_argument("--sharp-faces", metavar="FILE", help="faces split by Loop's rule: face indices, 0-based")
-    g.add_argument("--corners", metavar="FILE", help="corner vertices: vertex indices, 0-based")
+    if tag_files:
+        g.add_argument("--sharp-edges", metavar="FILE",
+                       help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
+        g.add_argument("--sharp-faces", metavar="FILE", help="faces split by Loop's rule: face indices, 0-based")
+        g.add_argument("--corners", metavar="FILE", help="corner vertices: vertex indices, 0-based")
     g.add_argument("--ignore-tags", action="store_true", help="ignore crease/corner tags stored in the input file")
     if input_opts:
         g = p.add_argument_group("input")
@@ -536,6 +568,34 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no messages (errors still shown)")
     s.set_defaults(func=cmd_subdivide)
+
+    b = sub.add_parser("batch", help="subdivide many mesh files on Dask; a rerun skips what is done",
+                       description="Subdivide every mesh of INPUTS (files, folders walked for mesh files, glob "
+                                   "patterns — quote them) into OUTDIR, one Dask task per mesh, with the code of "
+                                   "'subdivide'. A manifest (OUTDIR/hybridsub-manifest.jsonl) records each mesh as "
+                                   "it finishes; running the same command again skips what is done and redoes the "
+                                   "rest. Needs Dask: pip install 'hybridsub[batch]'. See docs/batch.md.",
+                       epilog="Exit codes: 0 every mesh done or skipped, 1 some mesh failed (listed, and in the "
+                              "manifest) or the batch could not run, 2 bad command line, 130 interrupted.")
+    b.add_argument("inputs", metavar="INPUT", nargs="+", help="mesh files, folders and glob patterns")
+    b.add_argument("-o", "--output", metavar="OUTDIR", required=True,
+                   help="output folder; outputs mirror the inputs' names below their folder or pattern")
+    b.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
+    b.add_argument("--format", choices=("obj", "ply", "npz"), default="obj",
+                   help="output format (default: obj); all three keep the tags")
+    _tag_options(b, tag_files=False)
+    g = b.add_argument_group("Dask").add_mutually_exclusive_group()
+    g.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on an existing cluster, e.g. tcp://10.0.0.5:8786 (default: start a local one)")
+    g.add_argument("--workers", type=_positive, metavar="N",
+                   help="processes of the local cluster (default: one per core)")
+    b.add_argument("--verify", action="store_true",
+                   help="before skipping a mesh done earlier, compare the SHA-256 of its input and output with "
+                        "the manifest's")
+    b.add_argument("--force", action="store_true",
+                   help="run meshes whose memory estimate exceeds 80%% of their worker's memory limit")
+    b.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table; failures still listed")
+    b.set_defaults(func=cmd_batch)
 
     c = sub.add_parser("compare", help="render input, √3, hybrid and Loop side by side into a PNG",
                        description="The paper's figures 4–6: the input with its sharp edges in red (semi-sharp in "
