@@ -487,6 +487,28 @@ def _default_workers() -> int:
         return os.cpu_count() or 1
 
 
+def local_cluster(workers: int, *, quiet: bool = True, **kwargs):
+    """(cluster, client): ``workers`` processes of one thread each, each with its share of the
+    cores for Numba's threads, and glibc's own malloc trimming. (Dask sets
+    ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers, which turns glibc's adaptive thresholds
+    off: every array above 128 KiB becomes a fresh mmap whose pages fault on first touch, and
+    each mesh took 1.4x as long.) ``kwargs`` go to ``LocalCluster``."""
+    import dask
+
+    distributed = _import_dask()
+    threads = max(1, _default_workers() // workers)
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        cluster = distributed.LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+            silence_logs=logging.CRITICAL if quiet else logging.ERROR,
+            env={"NUMBA_NUM_THREADS": str(threads)}, **kwargs)
+    try:
+        return cluster, distributed.Client(cluster, set_as_default=False)
+    except BaseException:
+        cluster.close()
+        raise
+
+
 def _connect(scheduler, workers: int | None, quiet: bool):
     """(client, things to close, description)."""
     distributed = _import_dask()
@@ -496,12 +518,7 @@ def _connect(scheduler, workers: int | None, quiet: bool):
         client = distributed.Client(scheduler, set_as_default=False)
         return client, [client], f"the scheduler at {scheduler}"
     n = _default_workers() if workers is None else workers
-    threads = max(1, _default_workers() // n)
-    cluster = distributed.LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-        silence_logs=logging.CRITICAL if quiet else logging.ERROR,
-        env={"NUMBA_NUM_THREADS": str(threads)})
-    client = distributed.Client(cluster, set_as_default=False)
+    cluster, client = local_cluster(n, quiet=quiet)
     return client, [client, cluster], f"a local cluster of {n} worker{'s' if n > 1 else ''}"
 
 
