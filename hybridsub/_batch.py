@@ -660,7 +660,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
 def _run(client, jobs: list[dict], manifest: Manifest, summary: BatchSummary, bar, t_start: float,
          on_result) -> None:
     """Submit ``jobs`` keeping a bounded number in flight, record each result as it comes."""
-    from distributed import KilledWorker, as_completed
+    from distributed import CancelledError, KilledWorker, as_completed
 
     run_id = uuid.uuid4().hex[:12]
     try:
@@ -687,14 +687,14 @@ def _run(client, jobs: list[dict], manifest: Manifest, summary: BatchSummary, ba
             records = []
             for fut in finished:
                 job = inflight.pop(fut.key)[1]
-                if fut.status == "finished":
+                try:  # a result lost with its worker since is computed again, and waited for here
                     rec = fut.result()
-                elif fut.status == "error":
-                    rec = _failed_on_cluster(job, fut.exception(), KilledWorker)
-                else:
-                    raise RuntimeError(f"Dask cancelled the task for {job['input']} ({fut.status}): the connection "
-                                       "to the scheduler was lost, or the scheduler restarted; what finished is in "
-                                       f"{manifest.path}: run again to finish")
+                except CancelledError:
+                    raise RuntimeError(f"Dask cancelled the task for {job['input']}: the connection to the "
+                                       "scheduler was lost, or the scheduler restarted; what finished is in "
+                                       f"{manifest.path}: run again to finish") from None
+                except Exception as e:  # run_task never raises: this came from the cluster
+                    rec = _failed_on_cluster(job, e, KilledWorker)
                 fut.release()
                 rec["run"] = run_id
                 rec["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="milliseconds")
