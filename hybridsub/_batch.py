@@ -272,8 +272,8 @@ class Manifest:
                                "wait for it, or use another output folder") from None
 
     def _read(self) -> None:
-        size = os.fstat(self.fd).st_size
-        data = os.pread(self.fd, size, 0) if size else b""
+        with open(self.path, "rb") as fh:
+            data = fh.read()
         end = data.rfind(b"\n") + 1
         if end < len(data):  # a line without its newline: the writer was killed in the middle of it
             os.ftruncate(self.fd, end)
@@ -610,6 +610,8 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
             raise ValueError(f"workers must be a positive integer, got {workers!r}")
     _import_dask()
     items, left_out = expand_inputs(inputs, outdir)
+    if not items:
+        raise ValueError("no inputs given: name mesh files, folders or glob patterns")
     os.makedirs(outdir, exist_ok=True)
     manifest = Manifest(outdir)
     closers: list = []

@@ -458,6 +458,9 @@ def test_usage_errors(collection, tmp_path, capsys):
         hybridsub.batch(mesh, os.path.dirname(mesh))
     with pytest.raises(ValueError, match="workers must be a positive integer"):
         hybridsub.batch(mesh, tmp_path / "o", workers=0)
+    with pytest.raises(ValueError, match="no inputs given"):
+        hybridsub.batch([], tmp_path / "o")
+    assert not os.path.exists(tmp_path / "o")  # nothing made for a batch that cannot run
     lock = Manifest(str(tmp_path))  # another batch holds the folder
     try:
         with pytest.raises(RuntimeError, match="another hybridsub batch is writing to this folder"):
