@@ -579,7 +579,9 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
     FileNotFoundError
         An input that does not exist, or a folder or pattern without mesh files.
     ValueError
-        A bad option, or an input inside ``outdir``.
+        A bad option, no inputs, or an input inside ``outdir``.
+    OSError
+        The scheduler cannot be reached (Dask's ``TimeoutError``).
     RuntimeError
         Another batch is writing to ``outdir``, or the cluster went away (rerun to finish).
 
