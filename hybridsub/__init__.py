@@ -11,6 +11,7 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 True
 """
 
+from ._batch import BatchSummary, batch
 from ._budget import get_memory_limit, set_memory_limit
 from ._errors import MeshError, OutputTooLargeError
 from ._examples import load_example
@@ -27,5 +28,6 @@ __all__ = [
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
+    "batch", "BatchSummary",
 ]
 __version__ = "0.1.0"

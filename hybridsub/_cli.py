@@ -1,4 +1,4 @@
-"""Command line: ``hybridsub subdivide | compare | info | demo``.
+"""Command line: ``hybridsub subdivide | batch | compare | info | demo``.
 
 Messages go to stderr (``--quiet`` silences all but errors), ``info`` writes its report to
 stdout. Exit codes: 0 success, 1 the input or the run failed (one line naming the problem),
@@ -199,13 +199,18 @@ def _ram_bytes() -> int | None:
 
 
 def _check_memory(a, pred: list[dict], what: str) -> None:
+    """Refuse a run whose estimated peak exceeds 80% of the memory at hand: the machine's RAM, or
+    ``a.memory_limit`` (bytes) where the caller has less (a batch task: its Dask worker's limit)."""
     if not pred:
         return
     peak = max(p["peak_bytes"] for p in pred)
-    ram = _ram_bytes()
+    ram, owner = _ram_bytes(), "this machine has"
+    limit = getattr(a, "memory_limit", None)
+    if limit and (not ram or limit < ram):
+        ram, owner = limit, "the Dask worker's memory limit is"
     if ram and peak > 0.8 * ram and not a.force:
         raise CLIError(f"{what} would need about {_bytes(peak)} of memory at level {len(pred)} "
-                       f"({pred[-1]['faces']:,} faces); this machine has {_bytes(ram)}. Use fewer levels, "
+                       f"({pred[-1]['faces']:,} faces); {owner} {_bytes(ram)}. Use fewer levels, "
                        "or --force to try anyway")
 
 
@@ -254,28 +259,52 @@ def _predict(mesh: TaggedMesh, levels: int, scheme: str, feat: Features, attribu
 
 
 def cmd_subdivide(a) -> int:
-    mesh = _load(a, a.input)
-    out_ext = os.path.splitext(a.output)[1].lower()
-    if not out_ext:
-        raise CLIError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .stl, .glb, …)")
-    feat = gather_features(a, mesh, a.input, a.scheme)
+    if not os.path.splitext(a.output)[1]:
+        raise CLIError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .npz, .stl, .glb, …)")
+    subdivide_file(a, a.input, a.output)
+    return 0
+
+
+@dataclass
+class FileResult:
+    """What :func:`subdivide_file` made, for the batch manifest."""
+    faces_in: int
+    faces_out: int
+    vertices_out: int
+    features: str  # the feature summary, as the command prints it
+    notes: list[str]  # what the reader did (from TaggedMesh.notes)
+    seconds_read: float
+    seconds_refine: float
+    seconds_write: float
+
+
+def subdivide_file(a, src: str, dst: str, write_to: str | None = None) -> FileResult:
+    """``hybridsub subdivide SRC -o DST`` with the options in ``a``: read, gather the features,
+    refine, write. ``write_to`` is the file actually written (the batch's temporary name, with
+    DST's extension); messages name DST."""
+    t0 = time.perf_counter()
+    mesh = _load(a, src)
+    feat = gather_features(a, mesh, src, a.scheme)
+    t_read = time.perf_counter() - t0
     _say(a, feat.summary)
-    out, seconds = _subdivide(a, mesh, feat, a.levels, a.scheme, a.input)
+    out, seconds = _subdivide(a, mesh, feat, a.levels, a.scheme, src)
     rate = f" ({_rate(len(out.faces) / seconds)} faces/s)" if seconds > 0 and a.levels else ""
     _say(a, f"{SCHEME_NAMES[a.scheme]}, {_n(a.levels, 'level')}: {len(mesh.faces):,} → {len(out.faces):,} faces, "
             f"{len(out.vertices):,} vertices in {seconds:.2f} s{rate}")
     if a.no_tags:
         out = TaggedMesh(out.vertices, out.faces, vertex_colors=out.vertex_colors, uv=out.uv, face_uv=out.face_uv)
     t = time.perf_counter()
-    dropped = _io.write(a.output, out, binary=not a.ascii)
+    dropped = _io.write(write_to or dst, out, binary=not a.ascii)
     dt = time.perf_counter() - t
     kept = _io.describe_tags(out)
     if dropped:
-        _say(a, f"wrote {a.output} in {dt:.2f} s — {out_ext} files cannot hold the {dropped}; "
+        _say(a, f"wrote {dst} in {dt:.2f} s — {os.path.splitext(dst)[1].lower()} files cannot hold the {dropped}; "
                 "write .obj or .ply to keep them")
     else:
-        _say(a, f"wrote {a.output} in {dt:.2f} s" + (f" with its {kept}" if kept else ""))
-    return 0
+        _say(a, f"wrote {dst} in {dt:.2f} s" + (f" with its {kept}" if kept else ""))
+    summary = feat.summary.removeprefix("features: ")
+    return FileResult(len(mesh.faces), len(out.faces), len(out.vertices), summary, list(mesh.notes), t_read,
+                      seconds, dt)
 
 
 def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, path: str):
@@ -321,6 +350,26 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     out = TaggedMesh(V, res.faces, res.sharp_edges, res.sharpness, res.corners,
                      np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv)
     return out, res.seconds
+
+
+def cmd_batch(a) -> int:
+    import logging
+
+    from ._batch import batch
+
+    # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    try:
+        s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
+                  feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format, loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate,
+                  weld=a.weld, force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
+                  progress=not a.quiet and sys.stderr.isatty())
+    except RuntimeError as e:
+        raise CLIError(str(e)) from None
+    lines = s.failure_lines() if a.quiet else [s.table()]
+    if lines:
+        print("\n".join(lines), file=sys.stderr)
+    return 0 if s.ok else 1
 
 
 def cmd_compare(a) -> int:
@@ -516,7 +565,23 @@ def _sharpness(text: str) -> float:
     return np.inf if x >= 10 else x
 
 
-def _tag_options(p, *, scheme=True, input_opts=True) -> None:
+def _positive(text: str) -> int:
+    try:
+        k = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
+    if k < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {k}")
+    return k
+
+
+def _uv_option(p) -> None:
+    p.add_argument("--uv-mode", choices=("linear", "smooth"),
+                   help="texture coordinates (OBJ vt, PLY s t): linear (default) interpolates them, seams kept, "
+                        "the texture undistorted; smooth subdivides them like the positions")
+
+
+def _tag_options(p, *, scheme=True, input_opts=True, tag_files=True) -> None:
     if scheme:
         p.add_argument("--scheme", choices=SCHEMES, default="hybrid",
                        help="hybrid (default): √3 on smooth faces, Loop on sharp ones; sqrt3: Kobbelt; loop")
@@ -526,9 +591,11 @@ def _tag_options(p, *, scheme=True, input_opts=True) -> None:
     g.add_argument("--feature-sharpness", type=_sharpness, metavar="S",
                    help="sharpness of the creases --feature-angle finds (default: inf, sharp for ever; "
                         "S > 0: semi-sharp, sharp for S levels, then rounding off; no corner tags)")
-    g.add_argument("--sharp-edges", metavar="FILE", help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
-    g.add_argument("--sharp-faces", metavar="FILE", help="faces split by Loop's rule: face indices, 0-based")
-    g.add_argument("--corners", metavar="FILE", help="corner vertices: vertex indices, 0-based")
+    if tag_files:
+        g.add_argument("--sharp-edges", metavar="FILE",
+                       help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
+        g.add_argument("--sharp-faces", metavar="FILE", help="faces split by Loop's rule: face indices, 0-based")
+        g.add_argument("--corners", metavar="FILE", help="corner vertices: vertex indices, 0-based")
     g.add_argument("--ignore-tags", action="store_true", help="ignore crease/corner tags stored in the input file")
     if input_opts:
         g = p.add_argument_group("input")
@@ -557,14 +624,41 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", metavar="OUT", required=True, help="output file; its extension picks the format")
     s.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
     _tag_options(s)
-    s.add_argument("--uv-mode", choices=("linear", "smooth"),
-                   help="texture coordinates (OBJ vt, PLY s t): linear (default) interpolates them, seams kept, "
-                        "the texture undistorted; smooth subdivides them like the positions")
+    _uv_option(s)
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
     s.add_argument("--ascii", action="store_true", help="PLY output in ASCII instead of binary")
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no messages (errors still shown)")
     s.set_defaults(func=cmd_subdivide)
+
+    b = sub.add_parser("batch", help="subdivide many mesh files on Dask; a rerun skips what is done",
+                       description="Subdivide every mesh of INPUTS (files, folders walked for mesh files, glob "
+                                   "patterns — quote them) into OUTDIR, one Dask task per mesh, with the code of "
+                                   "'subdivide'. A manifest (OUTDIR/hybridsub-manifest.jsonl) records each mesh as "
+                                   "it finishes; running the same command again skips what is done and redoes the "
+                                   "rest. Needs Dask: pip install 'hybridsub[batch]'. See docs/batch.md.",
+                       epilog="Exit codes: 0 every mesh done or skipped, 1 some mesh failed (listed, and in the "
+                              "manifest) or the batch could not run, 2 bad command line, 130 interrupted.")
+    b.add_argument("inputs", metavar="INPUT", nargs="+", help="mesh files, folders and glob patterns")
+    b.add_argument("-o", "--output", metavar="OUTDIR", required=True,
+                   help="output folder; outputs mirror the inputs' names below their folder or pattern")
+    b.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
+    b.add_argument("--format", choices=("obj", "ply", "npz"), default="obj",
+                   help="output format (default: obj); all three keep the tags")
+    _tag_options(b, tag_files=False)
+    _uv_option(b)
+    g = b.add_argument_group("Dask").add_mutually_exclusive_group()
+    g.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on an existing cluster, e.g. tcp://10.0.0.5:8786 (default: start a local one)")
+    g.add_argument("--workers", type=_positive, metavar="N",
+                   help="processes of the local cluster (default: one per core)")
+    b.add_argument("--verify", action="store_true",
+                   help="before skipping a mesh done earlier, compare the SHA-256 of its input and output with "
+                        "the manifest's")
+    b.add_argument("--force", action="store_true",
+                   help="run meshes whose memory estimate exceeds 80%% of their worker's memory limit")
+    b.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table; failures still listed")
+    b.set_defaults(func=cmd_batch)
 
     c = sub.add_parser("compare", help="render input, √3, hybrid and Loop side by side into a PNG",
                        description="The paper's figures 4–6: the input with its sharp edges in red (semi-sharp in "

@@ -1,5 +1,5 @@
 """Mesh files with their features: OBJ with OpenSubdiv's tags, PLY with tag elements, OFF,
-and every other format trimesh reads and writes.
+NumPy's NPZ (one array per attribute), and every other format trimesh reads and writes.
 
 OBJ, PLY and OFF are read and written here, vertex for vertex in file order, because crease
 and corner tags name vertices by index: a reader that merges or reorders vertices would move
@@ -25,7 +25,10 @@ __all__ = ["TaggedMesh", "read_mesh", "write_mesh"]
 #: Sharpness written for infinitely sharp creases and corners (OpenSubdiv's convention:
 #: a sharpness of 10 or more is infinitely sharp).
 INFINITE = 10.0
-_OWN_FORMATS = (".obj", ".ply", ".off")
+_OWN_FORMATS = (".obj", ".ply", ".off", ".npz")
+#: The arrays of an NPZ mesh file, in the order written (docs/formats.md).
+NPZ_ARRAYS = ("vertices", "faces", "sharp_edges", "sharpness", "corners", "sharp_faces", "vertex_colors", "uv",
+              "face_uv")
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,10 +108,11 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
     """Read a triangle mesh and its feature tags from a file.
 
     OBJ (with OpenSubdiv's ``t crease`` / ``t corner`` tags), PLY (with ``edge``, ``corner``
-    and ``sharp_face`` elements) and OFF are read by hybridsub, keeping every vertex where
-    the file has it; any other format trimesh reads (STL, GLB, glTF, 3MF, …) is read through
-    trimesh (STL's separate triangles are welded into one surface, and so are the vertices a
-    textured glTF duplicates along its UV seams, its UVs kept per face corner).
+    and ``sharp_face`` elements), OFF and NPZ (NumPy arrays named as the attributes of
+    :class:`TaggedMesh`) are read by hybridsub, keeping every vertex where the file has it;
+    any other format trimesh reads (STL, GLB, glTF, 3MF, …) is read through trimesh (STL's
+    separate triangles are welded into one surface, and so are the vertices a textured glTF
+    duplicates along its UV seams, its UVs kept per face corner).
 
     Parameters
     ----------
@@ -116,7 +120,8 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
         The file; its extension chooses the format.
     triangulate : bool
         Split polygons with more than three vertices into triangle fans. By default a polygon
-        is an error, since triangulating changes the subdivision surface.
+        is an error, since triangulating changes the subdivision surface. (NPZ files hold
+        triangles only.)
 
     Returns
     -------
@@ -152,6 +157,8 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
         mesh = _read_ply(path, triangulate)
     elif ext == ".off":
         mesh = _read_off(path, triangulate)
+    elif ext == ".npz":
+        mesh = _read_npz(path)
     else:
         mesh = _read_trimesh(path, ext)
     if len(mesh.faces) == 0:
@@ -325,7 +332,7 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangu
         notes.append("texture coordinates dropped: some faces have none")
     if origin is not None:
         notes.append(f"triangulated {len(faces)} polygons into {len(F)} triangles")
-    _check_range(path, F, len(V), "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, len(V), "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     if face_uv is not None and uv is not None:
         _check_range(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}")
     edges, sharpness, corners, sharp_faces, tag_notes, boundary_corners = _parse_tags(path, tags, len(V), len(faces))
@@ -471,7 +478,7 @@ def _read_off(path: str, triangulate: bool) -> TaggedMesh:
         if colors.max(initial=0) > 1:
             colors = colors / 255.0
     F, origin = _polygons(path, polys, triangulate)
-    _check_range(path, F, nv, "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, nv, "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     notes = (f"triangulated {nf} polygons into {len(F)} triangles",) if origin is not None else ()
     return TaggedMesh(V, F, vertex_colors=colors, notes=notes)
 
@@ -500,7 +507,7 @@ def _read_ply(path: str, triangulate: bool) -> TaggedMesh:
         F, origin = polys.astype(np.int64), None
     else:
         F, origin = _polygons(path, [list(map(int, p)) for p in polys], triangulate)
-    _check_range(path, F, n, "face", lambda f: f"face {int(origin[f]) if origin is not None else f}")
+    _check_range(path, F, n, "vertex", lambda f: f"face {int(origin[f]) if origin is not None else f}")
     uv = face_uv = None
     names = next(((a, b) for a, b in (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
                   if a in vd and b in vd), None)
@@ -548,6 +555,34 @@ def _read_ply(path: str, triangulate: bool) -> TaggedMesh:
         S = np.flatnonzero(np.isin(origin, S)) if origin is not None else np.unique(S)
     return TaggedMesh(np.ascontiguousarray(V), np.ascontiguousarray(F), E, s, C, S, colors, uv, face_uv,
                       tuple(notes))
+
+
+def _read_npz(path: str) -> TaggedMesh:
+    import zipfile
+
+    if not zipfile.is_zipfile(path):
+        raise MeshError(f"{path}: not an NPZ file (NumPy's savez writes a zip archive; this is not one)")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
+        raise MeshError(f"{path}: not a readable NPZ file ({type(e).__name__}: {e})") from None
+    missing = [k for k in ("vertices", "faces") if k not in arrays]
+    if missing:
+        raise MeshError(f"{path}: an NPZ mesh needs arrays 'vertices' and 'faces'; it has no {missing[0]!r} "
+                        f"(it holds {', '.join(repr(k) for k in sorted(arrays)) or 'nothing'})")
+    F = arrays["faces"]
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise MeshError(f"{path}: 'faces' must have shape (m, 3) (triangles), got {F.shape}")
+    if "face_uv" in arrays and "uv" not in arrays:
+        raise MeshError(f"{path}: 'face_uv' needs a 'uv' array")
+    try:
+        mesh = as_tagged(*(arrays.get(k) for k in NPZ_ARRAYS))
+    except (MeshError, TypeError) as e:
+        raise MeshError(f"{path}: {e}") from None
+    ignored = sorted(set(arrays) - set(NPZ_ARRAYS))
+    notes = (f"ignored arrays: {', '.join(ignored)}",) if ignored else ()
+    return replace(mesh, notes=notes)
 
 
 def _read_trimesh(path: str, ext: str) -> TaggedMesh:
@@ -620,8 +655,9 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *
     """Write a triangle mesh with its feature tags.
 
     OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
-    ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``edge`` (vertex1, vertex2,
-    crease), ``corner`` and ``sharp_face`` elements; OFF and every other format trimesh writes
+    ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``crease`` (vertex1, vertex2,
+    sharpness), ``corner`` and ``sharp_face`` elements; NPZ one array per attribute (the names
+    of :class:`TaggedMesh`'s, ``inf`` for infinitely sharp); OFF and every other format trimesh writes
     (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were dropped.
 
     Parameters
@@ -707,6 +743,9 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     if ext == ".ply":
         _write_ply(path, mesh, binary)
         return ""
+    if ext == ".npz":
+        _write_npz(path, mesh)
+        return ""
     if ext == ".off":
         _write_off(path, mesh)
     else:
@@ -779,6 +818,22 @@ def _write_off(path: str, m: TaggedMesh) -> None:
     parts += _rows("3 ", m.faces, "%d")
     with open(path, "w") as fh:
         fh.writelines(parts)
+
+
+def _write_npz(path: str, m: TaggedMesh) -> None:
+    """What np.savez writes (an uncompressed zip of .npy members), with fixed member dates so
+    that the same mesh always gives the same bytes."""
+    import zipfile
+
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
+        for name in NPZ_ARRAYS:
+            A = getattr(m, name)
+            if A is None:
+                continue
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.external_attr = 0o644 << 16
+            with z.open(info, "w", force_zip64=True) as fh:
+                np.lib.format.write_array(fh, np.ascontiguousarray(A), allow_pickle=False)
 
 
 def _write_ply(path: str, m: TaggedMesh, binary: bool) -> None:

@@ -130,3 +130,43 @@ class ProgressBar:
             self.stream.write("\n")
             self.stream.flush()
             self.shown = False
+
+
+class BatchProgress:
+    """One line on stderr for ``hybridsub batch``, redrawn as meshes finish (at most ten times a
+    second): bar and count of meshes finished (done or skipped) out of all, failures, meshes
+    and output faces per second of wall time. Silent unless enabled."""
+
+    def __init__(self, total: int, enabled: bool, stream=None):
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = enabled
+        self.total = total
+        self.shown = False
+        self.last = -1.0
+
+    def update(self, finished: int, failed: int, faces: int, seconds: float) -> None:
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if finished + failed < self.total and now - self.last < 0.1:
+            return
+        self.last = now
+        width = shutil.get_terminal_size((80, 20)).columns
+        frac = (finished + failed) / self.total if self.total else 1.0
+        bar_w = 20 if width >= 100 else 10
+        full = int(round(frac * bar_w))
+        info = f"{finished + failed:,}/{self.total:,} meshes"
+        if failed:
+            info += f" ({failed:,} failed)"
+        if seconds > 0:
+            info += f", {_si(faces / seconds)} faces/s"
+        line = f"batch [{'#' * full}{'.' * (bar_w - full)}] {frac * 100:3.0f}%  {info}"
+        self.stream.write("\r" + line[:width - 1].ljust(width - 1))
+        self.stream.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.enabled and self.shown:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.shown = False

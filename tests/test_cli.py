@@ -1,6 +1,7 @@
 """The command line end to end (subprocesses), its pieces in-process, and the engines behind it:
 level counts (info), level-by-level refinement (progress), the renderer (compare)."""
 
+import argparse
 import json
 import os
 import subprocess
@@ -297,6 +298,12 @@ def test_memory_guard(tmp_path, capsys, monkeypatch):
     assert main(["subdivide", off("cube-meshed"), "-o", str(tmp_path / "x.obj"), "--levels", "6"]) == 1
     err = capsys.readouterr().err
     assert "would need about" in err and "this machine has 50.0 MB" in err and "--force" in err
+    # a batch task checks against its Dask worker's memory limit where that is smaller
+    pred = [{"peak_bytes": 30_000_000, "faces": 1000}]
+    with pytest.raises(cli.CLIError, match="the Dask worker's memory limit is 20.0 MB"):
+        cli._check_memory(argparse.Namespace(force=False, memory_limit=20_000_000), pred, "3 levels")
+    cli._check_memory(argparse.Namespace(force=False, memory_limit=90_000_000), pred, "3 levels")  # RAM: 50 MB
+    cli._check_memory(argparse.Namespace(force=True, memory_limit=20_000_000), pred, "3 levels")
 
 
 # ----------------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Mesh files with features: OBJ tags in OpenSubdiv's convention, PLY tag elements, OFF, trimesh formats."""
+"""Mesh files with features: OBJ tags in OpenSubdiv's convention, PLY tag elements, OFF, NPZ, trimesh formats."""
 
 import os
 import warnings
@@ -28,7 +28,7 @@ def _write(path, text):
     return str(path)
 
 
-@pytest.mark.parametrize("ext,binary", [("obj", True), ("ply", True), ("ply", False)])
+@pytest.mark.parametrize("ext,binary", [("obj", True), ("ply", True), ("ply", False), ("npz", True)])
 def test_tags_round_trip_exactly(tmp_path, fandisk, ext, binary):
     V, F, E, s, C = fandisk
     sf = np.array([3, 17, 400, 12945])
@@ -41,7 +41,7 @@ def test_tags_round_trip_exactly(tmp_path, fandisk, ext, binary):
     assert np.array_equal(m.sharp_edges, E)
     assert np.array_equal(m.sharpness, s)  # inf stays inf (written as 10), finite values exactly
     assert np.array_equal(m.corners, C) and np.array_equal(m.sharp_faces, sf)
-    tol = 0 if ext == "obj" else 0.5 / 255  # PLY stores 8-bit colours
+    tol = 0.5 / 255 if ext == "ply" else 0  # PLY stores 8-bit colours
     assert np.abs(m.vertex_colors[:, :3] - colors).max() <= tol
     assert m.notes == ()
 
@@ -284,10 +284,51 @@ def test_read_errors(tmp_path):
         read_mesh(_write(tmp_path / "p.obj", "v 0 0 0\nv 1 0 0\n"))
     with pytest.raises(MeshError, match="not an OFF file"):
         read_mesh(_write(tmp_path / "x.off", "PLY\n"))
-    with pytest.raises(MeshError, match="face 0 refers to face index 7"):
+    with pytest.raises(MeshError, match="face 0 refers to vertex index 7"):
         read_mesh(_write(tmp_path / "r.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 8\n"))
     with pytest.raises(MeshError, match="not a PLY file"):
         read_mesh(_write(tmp_path / "x.ply", "hello\n"))
+
+
+def test_npz_files(tmp_path, fandisk):
+    """NPZ: plain np.load reads it, UVs with seams and semi-sharp creases come back exactly, the
+    same mesh gives the same bytes, and what is not a mesh is named."""
+    V, F, E, s, C = fandisk
+    uv = np.random.default_rng(1).random((len(F) * 3, 2))
+    fuv = np.arange(len(F) * 3).reshape(-1, 3)
+    for name in ("a.npz", "b.npz"):
+        write_mesh(tmp_path / name, V, F, sharp_edges=E, sharpness=s, corners=C, uv=uv, face_uv=fuv)
+    assert (tmp_path / "a.npz").read_bytes() == (tmp_path / "b.npz").read_bytes()
+    with np.load(tmp_path / "a.npz") as z:
+        assert sorted(z.files) == sorted(["vertices", "faces", "sharp_edges", "sharpness", "corners", "sharp_faces",
+                                          "uv", "face_uv"])
+        assert z["faces"].dtype == np.int64 and np.array_equal(z["sharpness"], s)
+    m = read_mesh(tmp_path / "a.npz")
+    assert np.array_equal(m.vertices, V) and np.array_equal(m.faces, F) and np.array_equal(m.sharpness, s)
+    assert np.array_equal(m.uv, uv) and np.array_equal(m.face_uv, fuv) and m.vertex_uv is None
+    np.savez(tmp_path / "extra.npz", vertices=V, faces=F, normals=V)
+    assert read_mesh(tmp_path / "extra.npz").notes == ("ignored arrays: normals",)
+    bad = {
+        "text.npz": "not an NPZ file",
+        "nofaces.npz": "an NPZ mesh needs arrays 'vertices' and 'faces'; it has no 'faces'",
+        "quads.npz": "'faces' must have shape (m, 3) (triangles), got (1, 4)",
+        "range.npz": "face 0 = [0, 1, 5] refers to vertex 5",
+        "edges.npz": "sharp edge 0 = [0, 9] refers to a vertex outside 0..3",
+        "objects.npz": "not a readable NPZ file",
+        "uvonly.npz": "'face_uv' needs a 'uv' array",
+    }
+    T = np.eye(4, 3)
+    (tmp_path / "text.npz").write_text("vertices faces")
+    np.savez(tmp_path / "nofaces.npz", vertices=T)
+    np.savez(tmp_path / "quads.npz", vertices=T, faces=[[0, 1, 2, 3]])
+    np.savez(tmp_path / "range.npz", vertices=T, faces=[[0, 1, 5]])
+    np.savez(tmp_path / "edges.npz", vertices=T, faces=[[0, 1, 2]], sharp_edges=[[0, 9]])
+    np.savez(tmp_path / "objects.npz", vertices=T, faces=np.array([[0, 1, 2]], dtype=object))
+    np.savez(tmp_path / "uvonly.npz", vertices=T, faces=[[0, 1, 2]], face_uv=[[0, 1, 2]])
+    for name, msg in bad.items():
+        with pytest.raises(MeshError) as e:
+            read_mesh(tmp_path / name)
+        assert str(e.value).startswith(str(tmp_path / name)) and msg in str(e.value), str(e.value)
 
 
 def test_write_does_not_touch_the_callers_arrays(tmp_path, fandisk):
