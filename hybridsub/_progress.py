@@ -89,35 +89,17 @@ def _si(x: float) -> str:
     return f"{x:.0f}"
 
 
-class ProgressBar:
-    """One line on stderr, redrawn after each level: bar (weighted by the predicted faces of
-    each level, since a level's cost is proportional to the faces it makes), level, faces,
-    faces per second. Silent unless enabled (the command line enables it when stderr is a
-    terminal and ``--quiet`` is not given)."""
+class _StatusLine:
+    """One line on a stream (stderr), redrawn in place: a label, a bar, a percentage and text."""
 
-    def __init__(self, predicted_faces: list[int], label: str, enabled: bool, stream=None):
+    def __init__(self, label: str, enabled: bool, stream=None):
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = enabled
         self.label = label
-        self.cum = np.cumsum([0] + list(predicted_faces), dtype=np.float64)
-        self.levels = len(predicted_faces)
         self.shown = False
-        if enabled:
-            self._draw(0, "starting")
 
-    def update(self, done: int, levels: int, n_faces: int, seconds: float) -> None:
-        if not self.enabled:
-            return
-        rate = n_faces / seconds if seconds > 0 else float("inf")
-        info = f"level {done}/{levels}: {n_faces:,} faces, {_si(rate)} faces/s"
-        if done < levels:
-            nxt = int(self.cum[min(done + 1, self.levels)] - self.cum[done])
-            info += f"; next {nxt:,}"
-        self._draw(done, info)
-
-    def _draw(self, done: int, info: str) -> None:
+    def draw(self, frac: float, info: str) -> None:
         width = shutil.get_terminal_size((80, 20)).columns
-        frac = self.cum[done] / self.cum[-1] if self.cum[-1] > 0 else 1.0
         bar_w = 20 if width >= 100 else 10
         full = int(round(frac * bar_w))
         line = f"{self.label} [{'#' * full}{'.' * (bar_w - full)}] {frac * 100:3.0f}%  {info}"
@@ -132,16 +114,41 @@ class ProgressBar:
             self.shown = False
 
 
-class BatchProgress:
+class ProgressBar(_StatusLine):
+    """One line on stderr, redrawn after each level: bar (weighted by the predicted faces of
+    each level, since a level's cost is proportional to the faces it makes), level, faces,
+    faces per second. Silent unless enabled (the command line enables it when stderr is a
+    terminal and ``--quiet`` is not given)."""
+
+    def __init__(self, predicted_faces: list[int], label: str, enabled: bool, stream=None):
+        super().__init__(label, enabled, stream)
+        self.cum = np.cumsum([0] + list(predicted_faces), dtype=np.float64)
+        self.levels = len(predicted_faces)
+        if enabled:
+            self._draw(0, "starting")
+
+    def update(self, done: int, levels: int, n_faces: int, seconds: float) -> None:
+        if not self.enabled:
+            return
+        rate = n_faces / seconds if seconds > 0 else float("inf")
+        info = f"level {done}/{levels}: {n_faces:,} faces, {_si(rate)} faces/s"
+        if done < levels:
+            nxt = int(self.cum[min(done + 1, self.levels)] - self.cum[done])
+            info += f"; next {nxt:,}"
+        self._draw(done, info)
+
+    def _draw(self, done: int, info: str) -> None:
+        self.draw(self.cum[done] / self.cum[-1] if self.cum[-1] > 0 else 1.0, info)
+
+
+class BatchProgress(_StatusLine):
     """One line on stderr for ``hybridsub batch``, redrawn as meshes finish (at most ten times a
     second): bar and count of meshes finished (done or skipped) out of all, failures, meshes
     and output faces per second of wall time. Silent unless enabled."""
 
     def __init__(self, total: int, enabled: bool, stream=None):
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = enabled
+        super().__init__("batch", enabled, stream)
         self.total = total
-        self.shown = False
         self.last = -1.0
 
     def update(self, finished: int, failed: int, faces: int, seconds: float) -> None:
@@ -151,22 +158,9 @@ class BatchProgress:
         if finished + failed < self.total and now - self.last < 0.1:
             return
         self.last = now
-        width = shutil.get_terminal_size((80, 20)).columns
-        frac = (finished + failed) / self.total if self.total else 1.0
-        bar_w = 20 if width >= 100 else 10
-        full = int(round(frac * bar_w))
         info = f"{finished + failed:,}/{self.total:,} meshes"
         if failed:
             info += f" ({failed:,} failed)"
         if seconds > 0:
             info += f", {_si(faces / seconds)} faces/s"
-        line = f"batch [{'#' * full}{'.' * (bar_w - full)}] {frac * 100:3.0f}%  {info}"
-        self.stream.write("\r" + line[:width - 1].ljust(width - 1))
-        self.stream.flush()
-        self.shown = True
-
-    def close(self) -> None:
-        if self.enabled and self.shown:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.shown = False
+        self.draw((finished + failed) / self.total if self.total else 1.0, info)
