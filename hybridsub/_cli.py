@@ -292,7 +292,8 @@ def subdivide_file(a, src: str, dst: str, write_to: str | None = None) -> FileRe
     _say(a, f"{SCHEME_NAMES[a.scheme]}, {_n(a.levels, 'level')}: {len(mesh.faces):,} → {len(out.faces):,} faces, "
             f"{len(out.vertices):,} vertices in {seconds:.2f} s{rate}")
     if a.no_tags:
-        out = TaggedMesh(out.vertices, out.faces, vertex_colors=out.vertex_colors, uv=out.uv, face_uv=out.face_uv)
+        out = TaggedMesh(out.vertices, out.faces, vertex_colors=out.vertex_colors, uv=out.uv, face_uv=out.face_uv,
+                         material_libs=out.material_libs, materials=out.materials, face_material=out.face_material)
     t = time.perf_counter()
     dropped = _io.write(write_to or dst, out, binary=not a.ascii)
     dt = time.perf_counter() - t
@@ -302,6 +303,8 @@ def subdivide_file(a, src: str, dst: str, write_to: str | None = None) -> FileRe
                 "write .obj or .ply to keep them")
     else:
         _say(a, f"wrote {dst} in {dt:.2f} s" + (f" with its {kept}" if kept else ""))
+    if out.materials and os.path.splitext(dst)[1].lower() != ".obj":
+        _say(a, f"note: the materials of {os.path.basename(src)} ('mtllib', 'usemtl') are kept in .obj output only")
     summary = feat.summary.removeprefix("features: ")
     return FileResult(len(mesh.faces), len(out.faces), len(out.vertices), summary, list(mesh.notes), t_read,
                       seconds, dt)
@@ -347,8 +350,10 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
     if keep_uv:
         uv, face_uv = res.uv, res.face_uv
     sf = res.sharp_faces
+    fm = None if mesh.face_material is None else mesh.face_material[res.face_parent]
     out = TaggedMesh(V, res.faces, res.sharp_edges, res.sharpness, res.corners,
-                     np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv)
+                     np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv,
+                     material_libs=mesh.material_libs, materials=mesh.materials, face_material=fm)
     return out, res.seconds
 
 

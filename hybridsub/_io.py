@@ -58,6 +58,13 @@ class TaggedMesh:
     notes : tuple of str
         What the reader did that a user should know (tags it could not use, vertices it
         welded, polygons it triangulated).
+    material_libs : tuple of str
+        OBJ's ``mtllib`` files, as absolute paths (the OBJ writer names them relative to the
+        file it writes, so a refined OBJ in another folder keeps its textures).
+    materials : tuple of str
+        OBJ's ``usemtl`` names, in order of first use.
+    face_material : (m,) int64, or None
+        Index into ``materials`` of each face (-1: before any ``usemtl``); None without materials.
 
     Examples
     --------
@@ -78,6 +85,9 @@ class TaggedMesh:
     uv: np.ndarray | None = None
     face_uv: np.ndarray | None = None
     notes: tuple = ()
+    material_libs: tuple = ()
+    materials: tuple = ()
+    face_material: np.ndarray | None = None
 
     @property
     def vertex_uv(self) -> np.ndarray | None:
@@ -196,6 +206,7 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
         text = fh.read().replace("\\\n", " ")
     lines = text.splitlines()
     v_lines, vt_lines, f_lines, tags = [], [], [], []
+    mats = _ObjMaterials(path)
     notes: list[str] = []
     ignored: set[str] = set()
     for number, line in enumerate(lines, start=1):
@@ -217,7 +228,7 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
             elif key in ("l", "p"):
                 ignored.add("lines and points ('l', 'p')")
             elif key in ("mtllib", "usemtl"):
-                ignored.add("materials ('mtllib', 'usemtl')")
+                mats.line(key, line, len(f_lines))
     fast = _obj_fast_faces(f_lines)
     if fast is None:
         return _read_obj_slow(path, lines, triangulate)
@@ -228,7 +239,7 @@ def _read_obj(path: str, triangulate: bool) -> TaggedMesh:
         vt_rows = np.pad(vt_rows[:, :2], ((0, 0), (0, 2 - min(vt_rows.shape[1], 2))))
     else:
         vt_rows = [ln.split()[:2] for ln in vt_lines]
-    return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate)
+    return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate, mats)
 
 
 def _fast_table(lines):
@@ -272,6 +283,7 @@ def _obj_fast_faces(f_lines):
 
 def _read_obj_slow(path: str, lines: list, triangulate: bool) -> TaggedMesh:
     v_rows, vt_rows, faces, fuv, tags = [], [], [], [], []
+    mats = _ObjMaterials(path)
     notes: list[str] = []
     ignored: set[str] = set()
     nv = nvt = 0
@@ -305,11 +317,41 @@ def _read_obj_slow(path: str, lines: list, triangulate: bool) -> TaggedMesh:
         elif key in ("l", "p"):
             ignored.add("lines and points ('l', 'p')")
         elif key in ("mtllib", "usemtl"):
-            ignored.add("materials ('mtllib', 'usemtl')")
-    return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate)
+            mats.line(key, line, len(faces))
+    return _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate, mats)
 
 
-def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate) -> TaggedMesh:
+class _ObjMaterials:
+    """``mtllib`` and ``usemtl`` lines of an OBJ file, and where each ``usemtl`` starts."""
+
+    def __init__(self, path: str):
+        self.folder = os.path.dirname(os.path.abspath(path))
+        self.libs: list[str] = []
+        self.names: list[str] = []
+        self.starts: list[tuple[int, int]] = []  # (first face, material index)
+
+    def line(self, key: str, line: str, n_faces: int) -> None:
+        rest = line.split(None, 1)[1].strip() if len(line.split(None, 1)) > 1 else ""
+        if key == "mtllib":
+            lib = os.path.normpath(os.path.join(self.folder, rest))
+            if rest and lib not in self.libs:
+                self.libs.append(lib)
+        elif rest:
+            if rest not in self.names:
+                self.names.append(rest)
+            self.starts.append((n_faces, self.names.index(rest)))
+
+    def face_material(self, n_faces: int) -> np.ndarray | None:
+        """(n_faces,) index into ``names`` per face as read (-1 before any ``usemtl``)."""
+        if not self.names:
+            return None
+        out = np.full(n_faces, -1, np.int64)
+        for first, k in self.starts:
+            out[first:] = k
+        return out
+
+
+def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangulate, mats) -> TaggedMesh:
     if ignored:
         notes.append("ignored " + ", ".join(sorted(ignored)))
     if len(faces) == 0:
@@ -344,8 +386,11 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, tags, notes, ignored, triangu
         if len(extra):
             tag_notes.append(f"'interpolateboundary 2': {len(extra)} boundary vertices in a single face "
                              "made corners")
+    face_material = mats.face_material(len(faces))
+    if face_material is not None and origin is not None:
+        face_material = face_material[origin]
     return TaggedMesh(V, F, edges, sharpness, corners, sharp_faces, colors, uv, face_uv,
-                      tuple(notes + tag_notes))
+                      tuple(notes + tag_notes), tuple(mats.libs), tuple(mats.names), face_material)
 
 
 def _obj_vertices(path, rows):
@@ -786,11 +831,22 @@ def _write_obj(path: str, m: TaggedMesh) -> None:
         parts += _rows("v ", np.hstack([m.vertices, m.vertex_colors[:, :3]]), "%r")
     else:
         parts += _rows("v ", m.vertices, "%r")
+    folder = os.path.dirname(os.path.abspath(path))
+    parts += [f"mtllib {_relative(lib, folder)}\n" for lib in m.material_libs]
     if m.uv is not None and m.face_uv is not None:
         parts += _rows("vt ", m.uv, "%r")
-        parts += _rows("f ", np.stack([m.faces + 1, m.face_uv + 1], axis=2).reshape(-1, 6), "%d/%d")
+        rows, fmt = np.stack([m.faces + 1, m.face_uv + 1], axis=2).reshape(-1, 6), "%d/%d"
     else:
-        parts += _rows("f ", m.faces + 1, "%d")
+        rows, fmt = m.faces + 1, "%d"
+    if m.face_material is None or not m.materials:
+        parts += _rows("f ", rows, fmt)
+    else:  # one usemtl line per run of faces with one material (children follow their parents)
+        fm = np.asarray(m.face_material)
+        cut = np.flatnonzero(np.r_[True, fm[1:] != fm[:-1]]).tolist() + [len(fm)]
+        for a, b in zip(cut[:-1], cut[1:]):
+            if fm[a] >= 0:
+                parts.append(f"usemtl {m.materials[fm[a]]}\n")
+            parts += _rows("f ", rows[a:b], fmt)
     s = np.where(np.isinf(m.sharpness), INFINITE, m.sharpness)
     if len(m.sharp_edges):
         E = m.sharp_edges.tolist()
@@ -803,6 +859,13 @@ def _write_obj(path: str, m: TaggedMesh) -> None:
         parts.append(f"t sharpface {len(chunk)}/0/0 " + " ".join(map(str, chunk)) + "\n")
     with open(path, "w") as fh:
         fh.writelines(parts)
+
+
+def _relative(path: str, folder: str) -> str:
+    try:
+        return os.path.relpath(path, folder)
+    except ValueError:  # another drive (Windows)
+        return path
 
 
 def _write_off(path: str, m: TaggedMesh) -> None:

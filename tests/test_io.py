@@ -388,3 +388,68 @@ def test_weld_merges_equal_uv_copies():
     uv[3] += 0.5  # a real seam at vertex 1 now: two UV indices there
     m, _, _ = _io.weld(_io.TaggedMesh(V, F, uv=uv, face_uv=F.copy()))
     assert m.face_uv.tolist() == [[0, 1, 2], [3, 4, 2]] and len(hybridsub.seam_edges(m.faces, m.face_uv)) == 1
+
+
+# ----------------------------------------------------------------------------------------------
+# OBJ materials: mtllib and usemtl travel with the faces
+
+_MATERIAL_OBJ = """mtllib lib/mats.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0.5 0.5 1
+f 1 2 5
+usemtl red
+f 2 3 5
+f 3 4 5
+usemtl blue paint
+f 4 1 5
+usemtl red
+f 1 3 2
+f 1 4 3
+"""
+
+
+@pytest.mark.parametrize("slow", [False, True])
+def test_obj_materials_read_and_written_relative_to_the_new_file(tmp_path, slow):
+    """Names in order of first use, a material per face (-1 before any usemtl), the library as
+    an absolute path; written elsewhere, mtllib names the same library relative to the new file
+    and usemtl lines follow the runs of faces. The careful reader (a tab) reads the same."""
+    (tmp_path / "src" / "lib").mkdir(parents=True)
+    text = _MATERIAL_OBJ.replace("f 1 2 5", "f\t1 2 5") if slow else _MATERIAL_OBJ
+    _write(tmp_path / "src" / "m.obj", text)
+    m = read_mesh(tmp_path / "src" / "m.obj")
+    assert m.materials == ("red", "blue paint")
+    assert m.face_material.tolist() == [-1, 0, 0, 1, 0, 0]
+    assert m.material_libs == (str(tmp_path / "src" / "lib" / "mats.mtl"),)
+    assert not any("material" in n for n in m.notes)
+    out = tmp_path / "elsewhere" / "deeper" / "o.obj"
+    _io.write(str(out), m)
+    lines = out.read_text().splitlines()
+    assert "mtllib ../../src/lib/mats.mtl" in lines
+    assert [ln for ln in lines if ln.startswith("usemtl")] == ["usemtl red", "usemtl blue paint", "usemtl red"]
+    back = read_mesh(out)
+    assert back.materials == m.materials and back.material_libs == m.material_libs
+    assert np.array_equal(back.face_material, m.face_material) and np.array_equal(back.faces, m.faces)
+
+
+def test_obj_materials_follow_polygons_and_subdivision(tmp_path, capsys):
+    """A quad split into two triangles keeps its material; 'hybridsub subdivide' gives each new
+    face its parent's material, and says that only OBJ output keeps them."""
+    from hybridsub._cli import main
+
+    _write(tmp_path / "q.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nusemtl a\nf 2 5 3\n"
+                               "usemtl b\nf 1 2 3 4\n")
+    m = read_mesh(tmp_path / "q.obj", triangulate=True)
+    assert m.face_material.tolist() == [0, 1, 1] and m.materials == ("a", "b")
+    assert main(["subdivide", str(tmp_path / "q.obj"), "-o", str(tmp_path / "q2.obj"), "--levels", "2",
+                 "--triangulate", "-q"]) == 0
+    r = hybridsub.refine(m.faces, None, 2, n_vertices=len(m.vertices))
+    out = read_mesh(tmp_path / "q2.obj")
+    assert out.materials == ("a", "b")
+    assert np.array_equal(out.face_material, m.face_material[r.face_parent])
+    assert main(["subdivide", str(tmp_path / "q.obj"), "-o", str(tmp_path / "q2.ply"), "--levels", "1",
+                 "--triangulate"]) == 0
+    assert "note: the materials of q.obj ('mtllib', 'usemtl') are kept in .obj output only" in \
+        capsys.readouterr().err
