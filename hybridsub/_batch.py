@@ -16,6 +16,7 @@ import glob
 import hashlib
 import json
 import logging
+import math
 import os
 import re
 import time
@@ -25,6 +26,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from ._errors import MeshError
+from ._rules import normalize_sharpness
 from ._typing import LoopWeights, Scheme
 from ._validate import check_options
 
@@ -442,7 +444,8 @@ def _options(levels, scheme, feature_angle, feature_sharpness, loop_weights, fmt
                              f"got {feature_sharpness!r}")
         if feature_angle is None:
             raise ValueError("feature_sharpness sets the sharpness of detected creases: give feature_angle too")
-        feature_sharpness = None if feature_sharpness >= 10 else float(feature_sharpness)  # >= 10: infinite
+        feature_sharpness = float(normalize_sharpness(feature_sharpness))
+        feature_sharpness = None if math.isinf(feature_sharpness) else feature_sharpness  # JSON has no inf
     if uv_mode not in (None, "linear", "smooth"):
         raise ValueError(f"uv_mode must be 'linear' or 'smooth', got {uv_mode!r}")
     return {"levels": levels, "scheme": scheme, "feature_angle": feature_angle,
@@ -537,8 +540,8 @@ def _connect(scheduler, workers: int | None, quiet: bool):
 def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str | os.PathLike, *, levels: int = 3,
           scheme: Scheme = "hybrid", feature_angle: float | None = None, feature_sharpness: float | None = None,
           format: str = "obj", loop_weights: LoopWeights = "loop", ignore_tags: bool = False,
-          triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, force: bool = False, scheduler=None, workers: int | None = None,
-          verify: bool = False, progress: bool = False, on_result: Callable[[dict], None] | None = None,
+          triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, force: bool = False,
+          scheduler=None, workers: int | None = None, verify: bool = False, progress: bool = False, on_result: Callable[[dict], None] | None = None,
           ) -> BatchSummary:
     """Subdivide many mesh files on Dask, one task per mesh, resuming where an earlier call stopped.
 

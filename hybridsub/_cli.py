@@ -12,7 +12,7 @@ import json
 import os
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -25,7 +25,8 @@ from ._features import detect_features
 from ._io import TaggedMesh
 from ._meshinfo import _edges, mesh_report, predict_levels
 from ._progress import ProgressBar, refine_by_level
-from ._validate import SCHEMES
+from ._rules import normalize_sharpness
+from ._validate import SCHEMES, count_of as _n
 
 SCHEME_NAMES = {"hybrid": "hybrid √3–Loop", "sqrt3": "Kobbelt √3", "loop": "Loop"}
 
@@ -51,12 +52,6 @@ class Features:
                     corners=self.corners)
 
 
-def _n(k: int, word: str) -> str:
-    if k == 1:
-        return f"1 {word}"
-    return f"{k:,} {word[:-2] + 'ices' if word.endswith('vertex') else word + 's'}"
-
-
 def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: float | None = None) -> Features:
     """Tags from the file, the tag files and --feature-angle, checked and merged; one-line summary."""
     n, m = len(mesh.vertices), len(mesh.faces)
@@ -64,7 +59,8 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     n_boundary = int((cnt == 1).sum())
     explicit = [o for o, v in (("--sharp-edges", a.sharp_edges), ("--sharp-faces", a.sharp_faces),
                                ("--corners", a.corners), ("--feature-angle", a.feature_angle),
-                               ("--feature-sharpness", getattr(a, "feature_sharpness", None))) if v is not None]
+                               ("--feature-sharpness", getattr(a, "feature_sharpness", None)))
+                if v is not None]
     file_tags = mesh.has_tags and not a.ignore_tags
     if scheme == "sqrt3":
         if explicit:
@@ -97,14 +93,15 @@ def gather_features(a, mesh: TaggedMesh, path: str, scheme: str, default_angle: 
     angle = a.feature_angle
     if angle is None and default_angle is not None and not E and not SF and not C:
         angle = default_angle
-    if angle is None and getattr(a, "feature_sharpness", None) is not None:
+    s_given = getattr(a, "feature_sharpness", None)
+    if angle is None and s_given is not None:
         raise CLIError("--feature-sharpness sets the sharpness of detected creases: give --feature-angle too")
     if angle is not None:
         try:
             feat = detect_features(mesh.vertices, mesh.faces, angle)
         except MeshError as err:
             raise CLIError(f"{path}: {err}") from None
-        s_feat = getattr(a, "feature_sharpness", None) or np.inf
+        s_feat = np.inf if s_given is None else float(normalize_sharpness(s_given))
         E.append(feat.sharp_edges)
         S.append(np.full(len(feat.sharp_edges), s_feat))
         if np.isinf(s_feat):
@@ -292,8 +289,8 @@ def subdivide_file(a, src: str, dst: str, write_to: str | None = None) -> FileRe
     _say(a, f"{SCHEME_NAMES[a.scheme]}, {_n(a.levels, 'level')}: {len(mesh.faces):,} → {len(out.faces):,} faces, "
             f"{len(out.vertices):,} vertices in {seconds:.2f} s{rate}")
     if a.no_tags:
-        out = TaggedMesh(out.vertices, out.faces, vertex_colors=out.vertex_colors, uv=out.uv, face_uv=out.face_uv,
-                         material_libs=out.material_libs, materials=out.materials, face_material=out.face_material)
+        out = replace(out, sharp_edges=np.empty((0, 2), np.int64), sharpness=np.empty(0),
+                      corners=np.empty(0, np.int64), sharp_faces=np.empty(0, np.int64))
     t = time.perf_counter()
     dropped = _io.write(write_to or dst, out, binary=not a.ascii)
     dt = time.perf_counter() - t
@@ -366,8 +363,8 @@ def cmd_batch(a) -> int:
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
     try:
         s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
-                  feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format, loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate,
-                  weld=a.weld, force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
+                  feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format,
+                  loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate, weld=a.weld, force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
                   progress=not a.quiet and sys.stderr.isatty())
     except RuntimeError as e:
         raise CLIError(str(e)) from None
@@ -567,7 +564,7 @@ def _sharpness(text: str) -> float:
         raise argparse.ArgumentTypeError(f"must be a number (inf: infinitely sharp), got {text!r}") from None
     if not x > 0:
         raise argparse.ArgumentTypeError(f"must be greater than 0, got {x:g}")
-    return np.inf if x >= 10 else x
+    return x
 
 
 def _positive(text: str) -> int:

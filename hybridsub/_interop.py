@@ -171,7 +171,7 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     except MeshError as e:
         if not w.welded:
             raise
-        merged = _count(n - len(w.V), "vertex", "vertices")
+        merged = val.count_of(n - len(w.V), "vertex")
         raise MeshError(f"{e} — in the welded mesh ({merged} at the position of an earlier one merged, vertices "
                         "numbered by first appearance); pass weld=False to subdivide the mesh as stored") from None
     parent = r.face_parent
@@ -225,8 +225,9 @@ def _weld(V, F, uv, data: dict) -> _Weld:
     degenerate = (Fg[:, 0] == Fg[:, 1]) | (Fg[:, 1] == Fg[:, 2]) | (Fg[:, 2] == Fg[:, 0])
     if degenerate.any():
         f = int(np.flatnonzero(degenerate)[0])
+        many = val.count_of(degenerate.sum(), "such face")
         raise MeshError(f"face {f} = {F[f].tolist()} has two corners at the same position (at {V[F[f]].tolist()}), "
-                        f"so it collapses when coincident vertices are welded ({_count(degenerate.sum(), 'such face')}); "
+                        f"so it collapses when coincident vertices are welded ({many}); "
                         "remove such faces (trimesh: mesh.update_faces(mesh.nondegenerate_faces())), or pass "
                         "weld=False")
     varying = frozenset(k for k, A in data.items() if not _same_on_copies(A, geo, geo_first))
@@ -293,11 +294,6 @@ class _Output:
         h = order[np.searchsorted(key[order], want)]
         tu, tw = T.ravel(), np.roll(T, -1, axis=1).ravel()
         return np.stack([tu[h], tw[h]], axis=1), sharp
-
-
-def _count(k, noun: str, plural: str | None = None) -> str:
-    k = int(k)
-    return f"{k} {noun if k == 1 else plural or noun + 's'}"
 
 
 def _vertex_uv(mesh) -> np.ndarray | None:

@@ -19,12 +19,13 @@ from numpy.typing import ArrayLike
 
 from . import _ply
 from ._errors import MeshError
+from ._rules import INFINITE_SHARPNESS
 
 __all__ = ["TaggedMesh", "read_mesh", "write_mesh"]
 
 #: Sharpness written for infinitely sharp creases and corners (OpenSubdiv's convention:
 #: a sharpness of 10 or more is infinitely sharp).
-INFINITE = 10.0
+INFINITE = INFINITE_SHARPNESS
 _OWN_FORMATS = (".obj", ".ply", ".off", ".npz")
 #: The arrays of an NPZ mesh file, in the order written (docs/formats.md).
 NPZ_ARRAYS = ("vertices", "faces", "sharp_edges", "sharpness", "corners", "sharp_faces", "vertex_colors", "uv",
@@ -331,12 +332,14 @@ class _ObjMaterials:
         self.starts: list[tuple[int, int]] = []  # (first face, material index)
 
     def line(self, key: str, line: str, n_faces: int) -> None:
-        rest = line.split(None, 1)[1].strip() if len(line.split(None, 1)) > 1 else ""
+        rest = line.strip()[len(key):].strip()  # one name, which may hold blanks
+        if not rest:
+            return
         if key == "mtllib":
             lib = os.path.normpath(os.path.join(self.folder, rest))
-            if rest and lib not in self.libs:
+            if lib not in self.libs:
                 self.libs.append(lib)
-        elif rest:
+        else:
             if rest not in self.names:
                 self.names.append(rest)
             self.starts.append((n_faces, self.names.index(rest)))

@@ -30,6 +30,14 @@ def check_options(scheme, levels, loop_weights) -> int:
 NON_MANIFOLD = ("raise", "cut")
 
 
+def count_of(k: int, word: str) -> str:
+    """``"1 vertex"``, ``"1,234 vertices"``, ``"2 such faces"``: a count and its noun, for messages."""
+    k = int(k)
+    if k == 1:
+        return f"1 {word}"
+    return f"{k:,} {word[:-2] + 'ices' if word.endswith('vertex') else word + 's'}"
+
+
 def check_non_manifold(non_manifold) -> str:
     if not isinstance(non_manifold, str) or non_manifold not in NON_MANIFOLD:
         raise ValueError(f"non_manifold must be one of {NON_MANIFOLD}, got {non_manifold!r}")

@@ -176,11 +176,18 @@ def test_loop_tends_to_plain_loop_as_sharpness_goes_to_zero(data):
         return hybridsub.refine(F, E, L, n_vertices=len(V), scheme="loop", sharpness=t * u, **rest)
 
     plain = hybridsub.refine(F, None, L, n_vertices=len(V), scheme="loop", **rest)
+    assert_limit_at_zero(S, plain.matrix, plain.faces)
+
+
+def assert_limit_at_zero(S, limit_matrix, limit_faces):
+    """``S(t)`` (the refinement with sharpness ``t u``) has the faces of the limit for every
+    t in (0, 1], is affine in t there (so ``2 S(t) - S(2t)`` is the limit itself), and tends to
+    it linearly."""
     a, b = S(0.25), S(0.5)
-    np.testing.assert_array_equal(a.faces, plain.faces)
-    assert dense_diff(2 * a.matrix - b.matrix, plain.matrix) < 1e-13
-    err = [dense_diff(S(t).matrix, plain.matrix) for t in (1e-3, 1e-6)]
-    assert err[1] <= 2e-6 and err[1] <= 1e-2 * max(err[0], 1e-300) + 1e-15
+    np.testing.assert_array_equal(a.faces, limit_faces)
+    assert dense_diff(2 * a.matrix - b.matrix, limit_matrix) < 1e-13
+    err = [dense_diff(S(t).matrix, limit_matrix) for t in (1e-3, 1e-6, 1e-9)]
+    assert err[1] <= 2e-6 and err[1] <= 1e-2 * max(err[0], 1e-300) + 1e-15 and err[2] < 1e-8
 
 
 def _r4_step(V, F, E, tags):
@@ -216,7 +223,4 @@ def test_hybrid_tends_to_the_split_smooth_edge_as_sharpness_goes_to_zero(data):
         after = hybridsub.refine(F1, None, L - 1, n_vertices=S1.shape[0], sharp_faces=sharp1,
                                  corners=tags.get("corners"))
         limit_matrix, limit_faces = (after.matrix @ S1).tocsr(), after.faces
-    a, b = S(0.25), S(0.5)
-    np.testing.assert_array_equal(a.faces, limit_faces)
-    assert dense_diff(2 * a.matrix - b.matrix, limit_matrix) < 1e-13
-    assert dense_diff(S(1e-9).matrix, limit_matrix) < 1e-8
+    assert_limit_at_zero(S, limit_matrix, limit_faces)
