@@ -33,8 +33,8 @@ import numpy as np
 from _bench import DATA, cpu_name
 
 import hybridsub
-from hybridsub._batch import MANIFEST, local_cluster
-from hybridsub._cli import subdivide_file
+from hybridsub._app.batch import MANIFEST, local_cluster
+from hybridsub._app.cli import subdivide_file
 
 
 def gear(teeth: int, layers: int, rng) -> tuple[np.ndarray, np.ndarray]:

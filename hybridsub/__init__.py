@@ -11,16 +11,16 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 True
 """
 
-from ._batch import BatchSummary, batch
-from ._budget import get_memory_limit, set_memory_limit
+from ._app.batch import BatchSummary, batch
+from ._refiner.budget import get_memory_limit, set_memory_limit
 from ._errors import MeshError, OutputTooLargeError
-from ._examples import load_example
-from ._facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
-from ._features import Features, detect_features
-from ._interop import subdivide_mesh
-from ._io import TaggedMesh, read_mesh, write_mesh
-from ._limit import limit_matrix, limit_normals, limit_positions
-from ._refine import Refinement, RefinementStep, refine, subdivide
+from ._io.examples import load_example
+from ._refiner.facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
+from ._input.features import Features, detect_features
+from ._app.interop import subdivide_mesh
+from ._io.mesh import TaggedMesh, read_mesh, write_mesh
+from ._refiner.limit import limit_matrix, limit_normals, limit_positions
+from ._refiner.refinement import Refinement, RefinementStep, refine, subdivide
 from . import analysis
 
 __all__ = [
@@ -30,4 +30,4 @@ __all__ = [
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
     "batch", "BatchSummary",
 ]
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: E402

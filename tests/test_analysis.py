@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from hybridsub import _rules as R
+from hybridsub._rules import refinement as R
 from hybridsub import analysis
-from hybridsub._topology import build_level
+from hybridsub._topology.level import build_level
 
 
 def _same_multiset(a, b, tol=1e-10):

@@ -20,10 +20,10 @@ from distributed import KilledWorker
 
 import hybridsub
 from conftest import DATA
-from hybridsub import _batch
-from hybridsub._batch import MANIFEST, TMPDIR, Manifest, assign_outputs, expand_inputs
-from hybridsub._cli import main
-from hybridsub._progress import BatchProgress
+from hybridsub._app import batch as _batch
+from hybridsub._app.batch import MANIFEST, TMPDIR, Manifest, assign_outputs, expand_inputs
+from hybridsub._app.cli import main
+from hybridsub._app.progress import BatchProgress
 from strategies import grid, sphere_hull, torus
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -580,7 +580,7 @@ def test_progress_bar_and_killed_worker_record():
 def test_run_task_records_what_went_wrong(tmp_path, monkeypatch):
     """The task never raises: another hybridsub version on the worker, and a bug (with its
     traceback), become failed records, and no temporary file stays behind."""
-    from hybridsub import _cli
+    from hybridsub._app import cli as _cli
 
     src = tmp_path / "t.off"
     src.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")

@@ -10,7 +10,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import hybridsub
-from hybridsub import OutputTooLargeError, _budget, _stencils
+from hybridsub import OutputTooLargeError
+from hybridsub._refiner import budget as _budget
+from hybridsub._refiner import stencils as _stencils
 
 import strategies as ms
 
@@ -28,9 +30,9 @@ def clean_limit(monkeypatch):
 
 def predicted(F, levels, scheme, keeps_steps=True, **tags):
     """The budget's Estimate before the first step (what refine checks against the limit)."""
-    from hybridsub import _validate as val
-    from hybridsub._refine import _prepare
-    from hybridsub._topology import plan_step
+    from hybridsub._input import arrays as val
+    from hybridsub._refiner.refinement import _prepare
+    from hybridsub._topology.level import plan_step
 
     levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
         F, tags.get("sharp_edges"), levels, None, scheme, tags.get("sharpness"), tags.get("sharp_faces"),
@@ -85,8 +87,8 @@ def test_refused_before_allocating(monkeypatch):
     def no(*a, **k):  # pragma: no cover - must not be reached
         raise AssertionError("a step matrix was built although the budget refused")
 
-    monkeypatch.setattr(hybridsub._refine, "step_matrix", no)
-    monkeypatch.setattr(hybridsub._refine, "apply_step", no)
+    monkeypatch.setattr(hybridsub._refiner.refinement, "step_matrix", no)
+    monkeypatch.setattr(hybridsub._refiner.refinement, "apply_step", no)
     with pytest.raises(OutputTooLargeError, match="set by max_memory"):
         hybridsub.refine(F, levels=9, max_memory="16G")
     with pytest.raises(OutputTooLargeError) as ei:
@@ -241,7 +243,7 @@ def test_real_int64_overflow():  # pragma: no cover - needs a big machine
 
 
 def test_command_line_reports_the_limit_and_force_lifts_it(monkeypatch, tmp_path, capsys):
-    from hybridsub import _cli
+    from hybridsub._app import cli as _cli
 
     V, F = ms.octahedron()
     src = tmp_path / "octa.off"

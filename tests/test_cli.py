@@ -13,9 +13,9 @@ import pytest
 import hybridsub
 from conftest import DATA, load_mesh
 from hybridsub import read_mesh
-from hybridsub._cli import main
-from hybridsub._meshinfo import mesh_report, predict_levels
-from hybridsub._progress import ProgressBar, refine_by_level
+from hybridsub._app.cli import main
+from hybridsub._app.report import mesh_report, predict_levels
+from hybridsub._app.progress import ProgressBar, refine_by_level
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -292,7 +292,7 @@ def test_info(capsys):
 
 
 def test_memory_guard(tmp_path, capsys, monkeypatch):
-    import hybridsub._cli as cli
+    import hybridsub._app.cli as cli
 
     monkeypatch.setattr(cli, "_ram_bytes", lambda: 50_000_000)
     assert main(["subdivide", off("cube-meshed"), "-o", str(tmp_path / "x.obj"), "--levels", "6"]) == 1
@@ -390,7 +390,7 @@ def test_mesh_report_on_broken_meshes():
 
 
 def test_renderer_hides_what_is_behind():
-    from hybridsub._render import render, view_rotation
+    from hybridsub._app.render import render, view_rotation
 
     # two squares facing the camera (+z); the second nearer, overlapping the first's upper right
     V = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0],
@@ -416,7 +416,7 @@ def test_renderer_hides_what_is_behind():
 def test_renderer_draws_a_texture_from_face_varying_uvs():
     """A square facing the camera, two triangles with their own UV indices (a seam on the
     diagonal, the UVs continuous across it): a 2 × 2 checkerboard lands in the four quarters."""
-    from hybridsub._render import render, view_rotation
+    from hybridsub._app.render import render, view_rotation
 
     V = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
     F = np.array([[0, 1, 2], [0, 2, 3]])
@@ -490,7 +490,7 @@ def test_textured_obj_with_sqrt3_and_other_formats(tmp_path, capsys):
 def test_textured_counts_are_predicted():
     """The counts info and the progress bar use include the split seams: exact with UVs, and
     without them (compare) the plain refinement's."""
-    from hybridsub._cli import Features, _predict
+    from hybridsub._app.cli import Features, _predict
 
     d = np.load(os.path.join(DATA, "bunny10k_textured.fvar_linear.L1.npz"))
     m = hybridsub.TaggedMesh(d["V_in"], d["F_in"], uv=d["UV_in"], face_uv=d["FUV_in"])

@@ -8,7 +8,7 @@ import pytest
 
 import hybridsub
 from hybridsub import MeshError, read_mesh, write_mesh
-from hybridsub import _io
+from hybridsub._io import mesh as _io
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 
@@ -234,7 +234,7 @@ end_header
     assert m.faces.tolist() == [[0, 1, 2], [0, 2, 3]]
     assert m.sharp_edges.tolist() == [[0, 1], [2, 3]] and m.sharpness.tolist() == [np.inf, 2.0]
     # binary PLY with a quad: the list lengths differ, the reader goes record by record
-    from hybridsub import _ply
+    from hybridsub._io import ply as _ply
 
     quad = tmp_path / "q.ply"
     _ply.write_ply(str(quad), [("vertex", [("x", "f4", np.arange(5.0)), ("y", "f4", np.zeros(5)),
@@ -437,7 +437,7 @@ def test_obj_materials_read_and_written_relative_to_the_new_file(tmp_path, slow)
 def test_obj_materials_follow_polygons_and_subdivision(tmp_path, capsys):
     """A quad split into two triangles keeps its material; 'hybridsub subdivide' gives each new
     face its parent's material, and says that only OBJ output keeps them."""
-    from hybridsub._cli import main
+    from hybridsub._app.cli import main
 
     _write(tmp_path / "q.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nusemtl a\nf 2 5 3\n"
                                "usemtl b\nf 1 2 3 4\n")

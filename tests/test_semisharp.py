@@ -21,9 +21,9 @@ from hypothesis import strategies as st
 
 import hybridsub
 import strategies as ms
-from hybridsub import _validate as val
-from hybridsub._stencils import step_matrix
-from hybridsub._topology import child_level, plan_step
+from hybridsub._input import arrays as val
+from hybridsub._refiner.stencils import step_matrix
+from hybridsub._topology.level import child_level, plan_step
 
 
 def cfg(n):

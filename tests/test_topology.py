@@ -5,10 +5,10 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from hybridsub import _kernels as K
+from hybridsub._topology import _kernels as K
 from hybridsub import refine
-from hybridsub._refine import _prepare, _walk
-from hybridsub._stencils import apply_step, step_matrix
+from hybridsub._refiner.refinement import _prepare, _walk
+from hybridsub._refiner.stencils import apply_step, step_matrix
 from strategies import tagged_meshes
 
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -77,7 +77,7 @@ def test_direct_application_equals_matrix_bit_for_bit(data, scheme, levels):
 def test_threaded_kernels_equal_serial_bit_for_bit(data, scheme, levels):
     """Small meshes run the serial twins; forcing the threaded ones must change no bit."""
     import hybridsub
-    from hybridsub import _kernels
+    from hybridsub._topology import _kernels as _kernels
 
     V, F, tags = data
     if scheme == "sqrt3":

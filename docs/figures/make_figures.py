@@ -155,7 +155,7 @@ def _phong(V, F, N, m):
 def fig_limit(out, quick):
     # A coarse model, where refinement and limit differ visibly: an octahedron with a crease
     # loop round its equator (the paper's Fig. 7: input, subdivided, limit).
-    from hybridsub._examples import read_off
+    from hybridsub._io.examples import read_off
     data = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data")
     V, F = read_off(os.path.join(data, "octahedron.off"))
     V = V * np.array([1.0, 1.0, 2.0])
@@ -203,11 +203,11 @@ def fig_limit(out, quick):
 
     # Convergence: |S_L V − L V| over the input vertices, against the predicted rates.
     fig, ax = plt.subplots(figsize=(6.2, 4.2))
-    cases = [("icosahedron", "sqrt3", {}, 2 / 3 - float(hybridsub._rules.kobbelt_alpha(5))),
+    cases = [("icosahedron", "sqrt3", {}, 2 / 3 - float(hybridsub._rules.refinement.kobbelt_alpha(5))),
              ("icosahedron", "loop", {}, ((3 + 2 * np.cos(2 * np.pi / 5)) / 8) ** 2),
              ("cube-meshed", "hybrid", "features", None), ("cube-meshed", "loop", "features", None)]
     data = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data")
-    from hybridsub._examples import read_off
+    from hybridsub._io.examples import read_off
     for name, scheme, tags, rate in cases:
         Vm, Fm = read_off(os.path.join(data, f"{name}.off"))
         kw = {}
@@ -243,7 +243,7 @@ def fig_spectra(out, quick):
             ax.plot(ns, [e[j] if j < len(e) else np.nan for e in ev], "o", ms=3, label=f"|λ{j + 1}|")
         cf = [analysis.closed_form_spectrum(int(n), scheme) for n in ns]
         if scheme == "sqrt3":
-            a = hybridsub._rules.kobbelt_alpha(ns)
+            a = hybridsub._rules.refinement.kobbelt_alpha(ns)
             ax.plot(ns, (2 + 2 * np.cos(2 * np.pi / ns)) / 9, "k-", lw=0.8, label="eq. (7): (2+2cos 2π/n)/9")
             ax.plot(ns, (2 - 3 * a) ** 2 / 9, "k--", lw=0.8, label="eq. (7): (2−3α_n)²/9")
             ax.set_title("√3, two steps (aligned ring)", fontsize=10)
@@ -314,7 +314,7 @@ def fig_semisharp(out, quick):
     # and Loop (bottom, OpenSubdiv's uniform creasing), 5 levels each.
     from PIL import Image
 
-    from hybridsub._figure import Panel, render_figure
+    from hybridsub._app.figure import Panel, render_figure
 
     V, F = _box()
     E = hybridsub.detect_features(V, F, angle=30).sharp_edges
@@ -357,7 +357,7 @@ def fig_textured(out, quick):
     seams, not welded). Bottom row: a close-up of a seam on the back."""
     import trimesh
 
-    from hybridsub import _render
+    from hybridsub._app import render as _render
 
     d = np.load(os.path.join(HERE, "..", "..", "tests", "data", "bunny10k_textured.fvar_linear.L1.npz"))
     V, F, UV, FUV = d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"]

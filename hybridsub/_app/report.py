@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from . import _rules as R
+from .._rules import refinement as R
 
 #: Bytes per face of one step's topology tables and classification (halfedge twins, edge
 #: numbering, vertex→edge incidence, step plan). Measured as the peak RSS of

@@ -24,7 +24,7 @@ import types
 
 from numba import njit, prange
 
-from ._rules import (
+from .._rules.refinement import (
     CORNER,
     EDGE_FLIP,
     EDGE_KEEP,

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import MeshError
+from .._errors import MeshError
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",

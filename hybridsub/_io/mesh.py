@@ -17,9 +17,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _ply
-from ._errors import MeshError
-from ._rules import INFINITE_SHARPNESS
+from . import ply as _ply
+from .._errors import MeshError
+from .._rules.refinement import INFINITE_SHARPNESS
 
 __all__ = ["TaggedMesh", "read_mesh", "write_mesh"]
 
@@ -747,7 +747,7 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
               vertex_colors=None, uv=None, face_uv=None) -> TaggedMesh:
     """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays)."""
-    from . import _validate as val
+    from .._input import arrays as val
 
     V = val.as_vertices(vertices)
     F, _ = val.as_faces(faces, len(V))
@@ -825,7 +825,7 @@ def _rows(prefix: str, A: np.ndarray, fmt: str) -> list[str]:
 
 
 def _write_obj(path: str, m: TaggedMesh) -> None:
-    from . import __version__
+    from .._version import __version__
 
     parts = [f"# hybridsub {__version__}: {len(m.vertices):,} vertices, {len(m.faces):,} triangles"
              + (f"; {describe_tags(m)}" if m.has_tags else "") + "\n",
@@ -903,7 +903,7 @@ def _write_npz(path: str, m: TaggedMesh) -> None:
 
 
 def _write_ply(path: str, m: TaggedMesh, binary: bool) -> None:
-    from . import __version__
+    from .._version import __version__
 
     vertex = [("x", "f8", m.vertices[:, 0]), ("y", "f8", m.vertices[:, 1]), ("z", "f8", m.vertices[:, 2])]
     if m.vertex_colors is not None:

@@ -30,7 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from . import _validate as val
+from .._input import arrays as val
 
 
 @dataclass(frozen=True, eq=False)

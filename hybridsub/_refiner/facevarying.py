@@ -29,14 +29,14 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from . import _budget
-from . import _rules as R
-from . import _validate as val
-from ._errors import MeshError
-from ._refine import Refinement, RefinementStep, check_uv_mode
-from ._stencils import apply_matrix, apply_step, step_matrix
-from ._topology import Level, StepPlan, child_creases, child_level, face_parents, plan_step
-from ._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
+from . import budget as _budget
+from .._rules import refinement as R
+from .._input import arrays as val
+from .._errors import MeshError
+from .refinement import Refinement, RefinementStep, check_uv_mode
+from .stencils import apply_matrix, apply_step, step_matrix
+from .._topology.level import Level, StepPlan, child_creases, child_level, face_parents, plan_step
+from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 
 
 class FaceVaryingRefinement(NamedTuple):
@@ -142,7 +142,7 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     >>> geo.faces.shape, uv.faces.shape, geo.matrix.shape, uv.matrix.shape
     ((12, 3), (12, 3), (11, 4), (14, 6))
     """
-    from ._refine import refine
+    from .refinement import refine
 
     geo = refine(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                  sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,

@@ -16,8 +16,8 @@ from functools import cached_property
 import numpy as np
 
 from . import _kernels as K
-from . import _rules as R
-from ._errors import MeshError
+from .._rules import refinement as R
+from .._errors import MeshError
 
 
 class Level:

@@ -6,8 +6,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _validate as val
-from ._typing import ArrayLike
+from . import arrays as val
+from .._typing import ArrayLike
 
 
 class Features(NamedTuple):

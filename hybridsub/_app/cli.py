@@ -16,17 +16,17 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import __version__
-from . import _io
-from ._errors import MeshError, OutputTooLargeError
-from ._examples import example_path
-from ._facevarying import seam_edges
-from ._features import detect_features
-from ._io import TaggedMesh
-from ._meshinfo import _edges, mesh_report, predict_levels
-from ._progress import ProgressBar, refine_by_level
-from ._rules import normalize_sharpness
-from ._validate import SCHEMES, count_of as _n
+from .._version import __version__
+from .._io import mesh as _io
+from .._errors import MeshError, OutputTooLargeError
+from .._io.examples import example_path
+from .._refiner.facevarying import seam_edges
+from .._input.features import detect_features
+from .._io.mesh import TaggedMesh
+from .report import _edges, mesh_report, predict_levels
+from .progress import ProgressBar, refine_by_level
+from .._rules.refinement import normalize_sharpness
+from .._input.arrays import SCHEMES, count_of as _n
 
 SCHEME_NAMES = {"hybrid": "hybrid √3–Loop", "sqrt3": "Kobbelt √3", "loop": "Loop"}
 
@@ -357,7 +357,7 @@ def _subdivide(a, mesh: TaggedMesh, feat: Features, levels: int, scheme: str, pa
 def cmd_batch(a) -> int:
     import logging
 
-    from ._batch import batch
+    from .batch import batch
 
     # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
@@ -375,7 +375,7 @@ def cmd_batch(a) -> int:
 
 
 def cmd_compare(a) -> int:
-    from ._figure import compare_panels, render_figure
+    from .figure import compare_panels, render_figure
 
     if not a.output.lower().endswith(".png"):
         raise CLIError(f"{a.output}: the figure is written as PNG; give a .png file name")
@@ -519,7 +519,7 @@ def cmd_demo(a) -> int:
         written.append(path)
     fig = os.path.join(a.output, "fandisk_compare.png")
     try:
-        from ._figure import compare_panels, render_figure
+        from .figure import compare_panels, render_figure
 
         ns.feature_angle = 30.0
         feat = gather_features(ns, mesh, src, "hybrid")

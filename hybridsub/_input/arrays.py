@@ -11,9 +11,9 @@ import operator
 
 import numpy as np
 
-from . import _rules as R
-from ._errors import MeshError
-from ._topology import build_level
+from .._rules import refinement as R
+from .._errors import MeshError
+from .._topology.level import build_level
 
 SCHEMES = ("hybrid", "sqrt3", "loop")
 

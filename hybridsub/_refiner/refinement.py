@@ -12,13 +12,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from . import _budget
-from . import _repair
-from . import _validate as val
-from ._features import merge_detected
-from ._stencils import apply_matrix, apply_step, step_matrix
-from ._topology import child_creases, child_level, face_parents, plan_step
-from ._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
+from . import budget as _budget
+from . import repair as _repair
+from .._input import arrays as val
+from .._input.features import merge_detected
+from .stencils import apply_matrix, apply_step, step_matrix
+from .._topology.level import child_creases, child_level, face_parents, plan_step
+from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
 
 
 @dataclass(frozen=True, eq=False)
@@ -244,7 +244,7 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
                                   loop_weights=loop_weights, max_memory=max_memory,
                                   uv=dict(uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode))
     if uv_faces is not None:  # the face-varying step loop (seams split), in _facevarying
-        from ._facevarying import refine_with_uvs
+        from .facevarying import refine_with_uvs
 
         return refine_with_uvs(F, uv_faces, sharp_edges, levels, n_vertices=n_vertices, n_uvs=n_uvs, scheme=scheme,
                                uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,

@@ -15,14 +15,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from . import _limit_kernels as LK
-from . import _limit_rules as LR
-from . import _rules as R
-from . import _validate as val
-from ._errors import MeshError
-from ._refine import refine
-from ._topology import Level, build_level
-from ._typing import ArrayLike, LoopWeights, Scheme
+from .._topology import _sector_kernels as LK
+from .._rules import limit as LR
+from .._rules import refinement as R
+from .._input import arrays as val
+from .._errors import MeshError
+from .refinement import refine
+from .._topology.level import Level, build_level
+from .._typing import ArrayLike, LoopWeights, Scheme
 
 # How a sector's normal is found.
 SEC_SMOOTH = 0  # cos/sin tangent masks (Kobbelt and Loop smooth vertices)
@@ -648,7 +648,7 @@ def _check_tol(tol, max_levels):
 def _features(V, F, feature_angle, sharp_edges, sharpness, corners):
     if feature_angle is None:
         return sharp_edges, sharpness, corners
-    from ._features import merge_detected
+    from .._input.features import merge_detected
 
     return merge_detected(V, F, feature_angle, sharp_edges, sharpness, corners)
 

@@ -30,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _rules as R
-from . import _stencils
-from ._errors import OutputTooLargeError
-from ._typing import MemoryLimit
+from .._rules import refinement as R
+from . import stencils as _stencils
+from .._errors import OutputTooLargeError
+from .._typing import MemoryLimit
 
 ENV_VAR = "HYBRIDSUB_MAX_MEMORY"
 DEFAULT_FRACTION = 0.8

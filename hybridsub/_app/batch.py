@@ -25,10 +25,10 @@ import uuid
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
-from ._errors import MeshError
-from ._rules import normalize_sharpness
-from ._typing import LoopWeights, Scheme
-from ._validate import check_options
+from .._errors import MeshError
+from .._rules.refinement import normalize_sharpness
+from .._typing import LoopWeights, Scheme
+from .._input.arrays import check_options
 
 __all__ = ["batch", "BatchSummary"]
 
@@ -348,8 +348,8 @@ def _worker_settings() -> tuple[str, int | None]:
 def run_task(job: dict) -> dict:
     """Subdivide one file: the worker's side of a batch. Never raises for a bad mesh: the
     record says ``"status": "failed"`` and why."""
-    from . import __version__
-    from ._cli import CLIError, subdivide_file
+    from .._version import __version__
+    from .cli import CLIError, subdivide_file
 
     t0 = time.perf_counter()
     src, dst = job["input"], job["output_path"]
@@ -612,8 +612,8 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
     >>> s.done, s.failed, sorted(os.listdir(os.path.join(d, "out")))
     (1, 0, ['fandisk.obj', 'hybridsub-manifest.jsonl'])
     """
-    from . import __version__
-    from ._progress import BatchProgress
+    from .._version import __version__
+    from .progress import BatchProgress
 
     t_start = time.perf_counter()
     options = _options(levels, scheme, feature_angle, feature_sharpness, loop_weights, format, ignore_tags,

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _render
-from ._refine import refine
+from . import render as _render
+from .._refiner.refinement import refine
 
 SCHEME_TITLES = {"sqrt3": "Kobbelt √3", "hybrid": "hybrid √3–Loop", "loop": "Loop"}
 
@@ -30,7 +30,7 @@ def compare_panels(V, F, levels: int, *, sharp_edges=None, sharpness=None, sharp
                    loop_weights="loop") -> list[Panel]:
     """Subdivide with the three schemes; the input panel shows creases (red: infinitely
     sharp, orange: semi-sharp) and boundary edges."""
-    from ._meshinfo import _edges
+    from .report import _edges
 
     E = np.empty((0, 2), np.int64) if sharp_edges is None else np.asarray(sharp_edges, dtype=np.int64).reshape(-1, 2)
     s = np.full(len(E), np.inf) if sharpness is None else np.asarray(sharpness, dtype=np.float64)

@@ -1,0 +1,1 @@
+"""The application layer: the file pipeline, command line, batch, progress, reports and figures."""

@@ -1,0 +1,1 @@
+"""The input gate: user arrays and options checked once, with errors that name the problem."""

@@ -1,0 +1,1 @@
+"""Mesh files: the data model, the formats, welding and tag lists."""

@@ -1,0 +1,1 @@
+"""Topology and tags (OpenSubdiv's Vtr): halfedges, levels, step plans, emission. No positions."""
