@@ -19,7 +19,7 @@ if os.path.isdir(os.path.join(ROOT, "hybridsub")) and ROOT not in sys.path:
     sys.path.insert(0, ROOT)  # benchmark the checkout this folder lives in, not an installed copy
 
 import hybridsub  # noqa: E402
-from hybridsub._io.examples import example_path, read_off  # noqa: E402
+from hybridsub._io import example_path, read_off  # noqa: E402
 
 MESHES = {
     "icosahedron": os.path.join(DATA, "icosahedron.off"),

@@ -42,7 +42,7 @@ import numpy as np
 from _bench import FIRST_CALL, HERE, ROOT, Timing, child_env, cpu_name, fresh_process, load, measure, tags  # noqa: E402
 
 import hybridsub  # noqa: E402  (_bench put this checkout's package first)
-from hybridsub._io.examples import read_off  # noqa: E402
+from hybridsub._io import read_off  # noqa: E402
 
 PEERS = os.path.join(HERE, "peers")
 

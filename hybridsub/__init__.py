@@ -11,16 +11,13 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 True
 """
 
-from ._app.batch import BatchSummary, batch
-from ._refiner.budget import get_memory_limit, set_memory_limit
 from ._errors import MeshError, OutputTooLargeError
-from ._io.examples import load_example
-from ._refiner.facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
-from ._input.features import Features, detect_features
-from ._app.interop import subdivide_mesh
-from ._io.mesh import TaggedMesh, read_mesh, write_mesh
-from ._refiner.limit import limit_matrix, limit_normals, limit_positions
-from ._refiner.refinement import Refinement, RefinementStep, refine, subdivide
+from ._input import Features, detect_features
+from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, limit_matrix,
+                       limit_normals, limit_positions, refine, refine_face_varying, seam_edges, set_memory_limit,
+                       subdivide, subdivide_face_varying)
+from ._io import TaggedMesh, load_example, read_mesh, write_mesh
+from ._app import BatchSummary, batch, subdivide_mesh
 from . import analysis
 
 __all__ = [

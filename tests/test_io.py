@@ -8,7 +8,7 @@ import pytest
 
 import hybridsub
 from hybridsub import MeshError, read_mesh, write_mesh
-from hybridsub._io import mesh as _io
+from hybridsub import _io
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 

@@ -155,7 +155,7 @@ def _phong(V, F, N, m):
 def fig_limit(out, quick):
     # A coarse model, where refinement and limit differ visibly: an octahedron with a crease
     # loop round its equator (the paper's Fig. 7: input, subdivided, limit).
-    from hybridsub._io.examples import read_off
+    from hybridsub._io import read_off
     data = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data")
     V, F = read_off(os.path.join(data, "octahedron.off"))
     V = V * np.array([1.0, 1.0, 2.0])
@@ -207,7 +207,7 @@ def fig_limit(out, quick):
              ("icosahedron", "loop", {}, ((3 + 2 * np.cos(2 * np.pi / 5)) / 8) ** 2),
              ("cube-meshed", "hybrid", "features", None), ("cube-meshed", "loop", "features", None)]
     data = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data")
-    from hybridsub._io.examples import read_off
+    from hybridsub._io import read_off
     for name, scheme, tags, rate in cases:
         Vm, Fm = read_off(os.path.join(data, f"{name}.off"))
         kw = {}

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from .._errors import MeshError
 from .._rules.refinement import normalize_sharpness
 from .._typing import LoopWeights, Scheme
-from .._input.arrays import check_options
+from .._input import check_options
 
 __all__ = ["batch", "BatchSummary"]
 

@@ -17,16 +17,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._version import __version__
-from .._io import mesh as _io
+from .. import _io
 from .._errors import MeshError, OutputTooLargeError
-from .._io.examples import example_path
-from .._refiner.facevarying import seam_edges
-from .._input.features import detect_features
-from .._io.mesh import TaggedMesh
+from .._io import example_path
+from .._refiner import seam_edges
+from .._input import detect_features
+from .._io import TaggedMesh
 from .report import _edges, mesh_report, predict_levels
 from .progress import ProgressBar, refine_by_level
 from .._rules.refinement import normalize_sharpness
-from .._input.arrays import SCHEMES, count_of as _n
+from .._input import SCHEMES, count_of as _n
 
 SCHEME_NAMES = {"hybrid": "hybrid √3–Loop", "sqrt3": "Kobbelt √3", "loop": "Loop"}
 

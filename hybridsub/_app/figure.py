@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import render as _render
-from .._refiner.refinement import refine
+from .._refiner import refine
 
 SCHEME_TITLES = {"sqrt3": "Kobbelt √3", "hybrid": "hybrid √3–Loop", "loop": "Loop"}
 

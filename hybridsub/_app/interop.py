@@ -6,11 +6,11 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from .._input import arrays as val
-from .._io.mesh import classes
+from .. import _input as val
+from .._io import classes
 from .._errors import MeshError
-from .._input.features import detect_features
-from .._refiner.refinement import Refinement, refine
+from .._input import detect_features
+from .._refiner import Refinement, refine
 from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._refiner.facevarying import subdivide_face_varying_levels
-from .._refiner.refinement import subdivide_levels
+from .._refiner import subdivide_face_varying_levels
+from .._refiner import subdivide_levels
 
 
 @dataclass

@@ -747,7 +747,7 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
               vertex_colors=None, uv=None, face_uv=None) -> TaggedMesh:
     """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays)."""
-    from .._input import arrays as val
+    from .. import _input as val
 
     V = val.as_vertices(vertices)
     F, _ = val.as_faces(faces, len(V))
