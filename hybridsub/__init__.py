@@ -17,7 +17,8 @@ from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_me
                        limit_normals, limit_positions, refine, refine_face_varying, seam_edges, set_memory_limit,
                        subdivide, subdivide_face_varying)
 from ._io import TaggedMesh, load_example, read_mesh, write_mesh
-from ._app import BatchSummary, batch, subdivide_mesh
+from ._app.batch import BatchSummary, batch
+from ._app.interop import subdivide_mesh
 from . import analysis
 
 __all__ = [

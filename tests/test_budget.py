@@ -30,16 +30,13 @@ def clean_limit(monkeypatch):
 
 def predicted(F, levels, scheme, keeps_steps=True, **tags):
     """The budget's Estimate before the first step (what refine checks against the limit)."""
-    from hybridsub._input import arrays as val
-    from hybridsub._refiner.refinement import _prepare
-    from hybridsub._topology.level import plan_step
+    from hybridsub._input.gate import open_gate
+    from hybridsub._topology import plan_step
 
-    levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
-        F, tags.get("sharp_edges"), levels, None, scheme, tags.get("sharpness"), tags.get("sharp_faces"),
-        tags.get("corners"), "loop")
-    level = val.checked_level(Fi, n, pairs).tag(pairs, sharp, face_sharp)
-    plan = plan_step(level, corner, scheme, 1, "loop")
-    return _budget.estimate(_budget.counts_of(level, plan), scheme, 1, levels, keeps_steps)
+    inp = open_gate(F, tags.get("sharp_edges"), levels, scheme=scheme, sharpness=tags.get("sharpness"),
+                    sharp_faces=tags.get("sharp_faces"), corners=tags.get("corners"))
+    plan = plan_step(inp.level, inp.corner, scheme, 1, "loop")
+    return _budget.estimate(_budget.counts_of(inp.level, plan), scheme, 1, inp.levels, keeps_steps)
 
 
 # ----------------------------------------------------------------- the estimate
@@ -88,7 +85,7 @@ def test_refused_before_allocating(monkeypatch):
         raise AssertionError("a step matrix was built although the budget refused")
 
     monkeypatch.setattr(hybridsub._refiner.refinement, "step_matrix", no)
-    monkeypatch.setattr(hybridsub._refiner.refinement, "apply_step", no)
+    monkeypatch.setattr(hybridsub._refiner.fastpath, "apply_step", no)
     with pytest.raises(OutputTooLargeError, match="set by max_memory"):
         hybridsub.refine(F, levels=9, max_memory="16G")
     with pytest.raises(OutputTooLargeError) as ei:

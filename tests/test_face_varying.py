@@ -615,7 +615,7 @@ def test_random_charts_stay_aligned_and_seams_are_never_flipped(data, scheme, uv
     r = hybridsub.refine(F, levels=L, n_vertices=len(V), uv_faces=FUV, n_uvs=len(UV), scheme=scheme,
                          uv_mode=uv_mode, **tags)
     G, T, P = r.faces, r.uv_faces, r.face_parent
-    assert G.shape == T.shape and r.uv_matrix.shape == (r._uv.n_vertices, len(UV))
+    assert G.shape == T.shape and r.uv_matrix.shape == (r.uv_refinement.n_vertices, len(UV))
     # the fast path (no matrices) gives the bits of the step matrices applied in turn
     V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=L, scheme=scheme, uv_mode=uv_mode,
                                                          **tags)

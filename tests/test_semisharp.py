@@ -23,7 +23,7 @@ import hybridsub
 import strategies as ms
 from hybridsub._input import arrays as val
 from hybridsub._refiner.stencils import step_matrix
-from hybridsub._topology.level import child_level, plan_step
+from hybridsub._topology import checked_level, child_level, plan_step
 
 
 def cfg(n):
@@ -197,7 +197,7 @@ def _r4_step(V, F, E, tags):
     face_sharp, _ = val.as_face_mask(tags.get("sharp_faces"), len(Fi))
     corner = val.as_corner_mask(tags.get("corners"), n)
     none = np.empty((0, 2), np.int64)
-    level = val.checked_level(Fi, n, none).tag(none, np.empty(0), face_sharp)
+    level = checked_level(Fi, n, none).tag(none, np.empty(0), face_sharp)
     want = {frozenset(map(int, e)) for e in np.asarray(E)}
     force = np.array([frozenset((int(Fi[h // 3, h % 3]), int(Fi[h // 3, (h % 3 + 1) % 3]))) in want
                       for h in range(3 * len(Fi))])

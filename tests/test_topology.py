@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 
 from hybridsub._topology import _kernels as K
 from hybridsub import refine
-from hybridsub._refiner.refinement import _prepare, _walk
+from hybridsub._input.gate import open_gate
+from hybridsub._refiner.loop import walk
 from hybridsub._refiner.stencils import apply_step, step_matrix
 from strategies import tagged_meshes
 
@@ -15,10 +16,9 @@ SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[Healt
 
 
 def _levels(V, F, tags, scheme, levels):
-    args = _prepare(F, tags.get("sharp_edges"), levels, len(V), scheme, tags.get("sharpness"),
-                    tags.get("sharp_faces"), tags.get("corners"), "loop")
-    levels, Fi, n, pairs, sharp, face_sharp, _, corner = args
-    return list(_walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, "loop", topology_last=True))
+    inp = open_gate(F, tags.get("sharp_edges"), levels, n_vertices=len(V), scheme=scheme,
+                    sharpness=tags.get("sharpness"), sharp_faces=tags.get("sharp_faces"), corners=tags.get("corners"))
+    return [(s.level, s.plan, s.faces, s.child, s.offsets) for s in walk(inp, topology_last=True)]
 
 
 @SETTINGS

@@ -249,7 +249,7 @@ class _Output:
         self.r, self.w = r, w
         self.faces: np.ndarray = r.faces
         self.geo_of: np.ndarray | None = None  # welded fine vertex of each output vertex
-        self.uv_r: Refinement | None = r._uv
+        self.uv_r: Refinement | None = r.uv_refinement
         self.corner_first = np.empty(0, np.int64) if w.corner_first is None else w.corner_first
         if r.uv_faces is not None and self.uv_r is not None:
             self.faces = r.uv_faces

@@ -1,10 +1,13 @@
 """The input gate: user arrays and options checked once, with errors that name the problem,
-and the features detected on them. Other layers import from here, never from the modules
-inside."""
+the features detected on them, and the frozen description of one refinement
+(:class:`RefineInput`) that every layer below takes. Other layers import from here, never
+from the modules inside."""
 
-from .arrays import (SCHEMES, as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices, check_options,
-                     count_of)
+from .arrays import (SCHEMES, UV_MODES, as_corner_mask, as_data, as_face_mask, as_faces, as_sharp_edges,
+                     as_uv_values, as_vertices, check_options, count_of)
 from .features import Features, detect_features
+from .gate import RefineInput, UVInput, open_gate
 
-__all__ = ["Features", "SCHEMES", "as_corner_mask", "as_face_mask", "as_faces", "as_sharp_edges", "as_vertices",
-           "check_options", "count_of", "detect_features"]
+__all__ = ["Features", "RefineInput", "SCHEMES", "UVInput", "UV_MODES", "as_corner_mask", "as_data",
+           "as_face_mask", "as_faces", "as_sharp_edges", "as_uv_values", "as_vertices", "check_options", "count_of",
+           "detect_features", "open_gate"]

@@ -13,7 +13,6 @@ import numpy as np
 
 from .._rules import refinement as R
 from .._errors import MeshError
-from .._topology.level import build_level
 
 SCHEMES = ("hybrid", "sqrt3", "loop")
 
@@ -28,6 +27,13 @@ def check_options(scheme, levels, loop_weights) -> int:
 
 
 NON_MANIFOLD = ("raise", "cut")
+UV_MODES = ("linear", "smooth")
+
+
+def check_uv_mode(uv_mode) -> str:
+    if not isinstance(uv_mode, str) or uv_mode not in UV_MODES:
+        raise ValueError(f"uv_mode must be one of {UV_MODES}, got {uv_mode!r}")
+    return uv_mode
 
 
 def count_of(k: int, word: str) -> str:
@@ -280,108 +286,44 @@ def _indices(A, n: int, name: str, what: str) -> np.ndarray:
     return A.astype(np.int64)
 
 
-# --------------------------------------------------------------------------------------
-# Topology: what build_level cannot take, named
+def as_uv_faces(FUV, m: int, n_uvs: int | None, name: str = "FUV") -> np.ndarray:
+    """(m, 3) int64 UV faces, checked against the ``m`` faces and ``n_uvs`` UV values; errors
+    name the argument (``name``) and the first bad face."""
+    A = as_array(FUV, name, 3, "face", "m")
+    if A.ndim == 1 and A.size == 0 and m == 0:
+        A = A.reshape(0, 3)
+    if A.dtype == bool or not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
+        raise TypeError(f"{name} must hold integer UV indices, got dtype {A.dtype}")
+    if A.ndim != 2 or A.shape[1] != 3 or A.shape[0] != m:
+        raise MeshError(f"{name} must have shape ({m}, 3), one row of UV indices per face, got {A.shape}")
+    if np.issubdtype(A.dtype, np.floating) and A.size:
+        frac = not_integral(A)
+        if frac.any():
+            f = int(np.flatnonzero(frac)[0])
+            raise MeshError(f"{name} must hold integer UV indices; face {f} has {A[f].tolist()}")
+    T = np.ascontiguousarray(A, dtype=np.int64)
+    if T.size:
+        neg = (T < 0).any(axis=1)
+        if neg.any():
+            f = int(np.flatnonzero(neg)[0])
+            raise MeshError(f"{name}: face {f} has a negative UV index: {T[f].tolist()}")
+        if n_uvs is not None and T.max() >= n_uvs:
+            f = int(np.flatnonzero((T >= n_uvs).any(axis=1))[0])
+            raise MeshError(f"{name}: face {f} has UV indices {T[f].tolist()}, but there are only {n_uvs} UV values "
+                            f"(valid indices 0..{n_uvs - 1})")
+    return T
 
 
-def checked_level(F: np.ndarray, n: int, pairs: np.ndarray | None = None):
-    """``build_level(F, n)``, with every topology problem reported by name.
-
-    Reports duplicate faces, non-manifold edges and inconsistent orientation (with how to fix
-    each), and sharp edges (``pairs``) that are not edges of the mesh.
-    """
-    try:
-        level = build_level(F, n)
-    except MeshError as exc:
-        raise (topology_error(F) or exc) from None
-    if level.n_faces:
-        t = level.twin.reshape(-1, 3)
-        tf = t // 3
-        # A face whose three edges all lie in the same other face: a duplicate with opposite
-        # orientation, the two making a closed two-triangle "pillow" build_level accepts.
-        pillow = (t >= 0).all(axis=1) & (tf[:, 0] == tf[:, 1]) & (tf[:, 1] == tf[:, 2])
-        if pillow.any():
-            raise duplicate_faces_error(F)
-    if pairs is not None and len(pairs):
-        eid = level.find_edges(pairs)
-        missing = (eid < 0) | (pairs[:, 0] == pairs[:, 1])
-        if missing.any():
-            raise not_an_edge_error(pairs, np.flatnonzero(missing))
-    return level
-
-
-def not_an_edge_error(pairs: np.ndarray, missing: np.ndarray) -> MeshError:
-    j = int(missing[0])
-    u, w = int(pairs[j, 0]), int(pairs[j, 1])
-    why = f"it joins vertex {u} to itself" if u == w else f"no face has both vertex {u} and vertex {w}"
-    more = f" ({len(missing)} such rows)" if len(missing) > 1 else ""
-    return MeshError(f"sharp edge {j} = [{u}, {w}] is not an edge of the mesh: {why}{more}")
-
-
-def duplicate_faces_error(F: np.ndarray) -> MeshError | None:
-    """A MeshError naming the first face that repeats an earlier one's vertices, or None."""
-    if len(F) < 2:
-        return None
-    S = np.sort(F, axis=1)
-    order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))  # stable: ties in face order
-    Ss = S[order]
-    same = (Ss[1:] == Ss[:-1]).all(axis=1)
-    if not same.any():
-        return None
-    new = np.concatenate([[True], ~same])
-    first = order[new][np.cumsum(new) - 1]  # the lowest face of each group
-    dup = order[1:][same]
-    orig = first[1:][same]
-    k = int(np.argmin(dup))
-    f, g = int(orig[k]), int(dup[k])
-    rotations = [np.roll(F[g], r) for r in range(3)]
-    how = "the same" if any((x == F[f]).all() for x in rotations) else "opposite"
-    return MeshError(
-        f"faces {f} and {g} are duplicate faces: both are the triangle on vertices {sorted(F[f].tolist())}, "
-        f"with {how} orientation ({int(same.sum())} duplicate face{'s' if same.sum() > 1 else ''} in all); "
-        "remove the duplicates "
-        "first, e.g. with trimesh: mesh.update_faces(mesh.unique_faces())"
-    )
-
-
-def topology_error(F: np.ndarray) -> MeshError | None:
-    """The first topology problem of F, described with a fix: duplicate faces, then edges in
-    three or more faces, then edges whose two faces disagree on orientation. None if none."""
-    dup = duplicate_faces_error(F)
-    if dup is not None:
-        return dup
-    m = len(F)
-    u = F.ravel()
-    w = F[:, [1, 2, 0]].ravel()
-    lo, hi = np.minimum(u, w), np.maximum(u, w)
-    order = np.lexsort((hi, lo))  # halfedges by edge, ties in halfedge order
-    ls, hs = lo[order], hi[order]
-    new = np.ones(3 * m, dtype=bool)
-    new[1:] = (ls[1:] != ls[:-1]) | (hs[1:] != hs[:-1])
-    starts = np.flatnonzero(new)
-    sizes = np.diff(np.append(starts, 3 * m))
-    a = order[starts]
-    b = order[np.minimum(starts + 1, 3 * m - 1)]
-    many = sizes >= 3
-    if many.any():
-        g = int(np.flatnonzero(many)[np.argmin(a[many])])
-        faces = sorted((order[starts[g]:starts[g] + sizes[g]] // 3).tolist())
-        more = f"; {int(many.sum())} such edges in all" if many.sum() > 1 else ""
-        return MeshError(
-            f"edge ({int(ls[starts[g]])}, {int(hs[starts[g]])}) is shared by {len(faces)} faces {faces}: the "
-            f"mesh is not edge-manifold (every edge must lie in one or two faces){more}. Remove the extra "
-            "faces, or pass non_manifold=\"cut\" to cut the mesh along such edges (they become creases "
-            "where the pieces meet; see docs/errors.md)"
-        )
-    flipped = (sizes == 2) & (u[a] == u[b])
-    if flipped.any():
-        g = int(np.flatnonzero(flipped)[np.argmin(a[flipped])])
-        h1, h2 = int(a[g]), int(b[g])
-        more = f"; {int(flipped.sum())} such edges in all" if flipped.sum() > 1 else ""
-        return MeshError(
-            f"faces {h1 // 3} and {h2 // 3} both run along edge {int(u[h1])}->{int(w[h1])} in the same "
-            f"direction: the mesh is not consistently oriented{more}. Reverse the vertex order of the faces "
-            "on one side (e.g. trimesh.repair.fix_winding(mesh), or igl.bfs_orient(F)); a surface that "
-            "cannot be oriented (a Möbius strip) can be cut along such edges with non_manifold=\"cut\""
-        )
-    return None
+def as_uv_values(UV) -> np.ndarray:
+    """(t, k) float64 face-varying values (UVs), checked finite; never a view the caller can see written."""
+    A = np.asarray(UV)
+    if A.dtype == object or not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
+        raise TypeError(f"UV must be a numeric array of shape (t, k), got dtype {A.dtype}")
+    if A.ndim not in (1, 2):
+        raise MeshError(f"UV must have shape (t, k) (one row per UV value), got {A.shape}")
+    A = np.ascontiguousarray(A, dtype=np.float64)
+    bad = ~np.isfinite(A.reshape(len(A), -1)).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"UV value {i} is not finite: {A[i].tolist()}")
+    return A

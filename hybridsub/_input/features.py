@@ -6,6 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._topology import checked_level
 from . import arrays as val
 from .._typing import ArrayLike
 
@@ -88,7 +89,7 @@ def detect_features(V: ArrayLike, F: ArrayLike, angle: float = 30.0, *,
     if len(Fi) == 0:
         empty = np.empty((0, 2), np.int64)
         return Features(empty, empty.copy(), np.empty(0, np.int64))
-    level = val.checked_level(Fi, n)
+    level = checked_level(Fi, n)
     ev = level.edge_vertices
     owner = level.edge_owner
     twin = level.twin[owner]

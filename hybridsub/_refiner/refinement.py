@@ -1,24 +1,25 @@
-"""Refinement: the step loop, and the objects that hold its results.
+"""Refinement matrices: ``refine``, and the objects that hold its results.
 
 A :class:`Refinement` is what ``refine`` returns: connectivity, tags and refinement
-matrices, computed from topology and tags alone. Its :meth:`Refinement.apply` refines any
-per-vertex data with them.
+matrices, computed from topology and tags alone by the step loop (:mod:`.loop`). Its
+:meth:`Refinement.apply` refines any per-vertex data with them.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
-from . import budget as _budget
-from . import repair as _repair
-from .._input import arrays as val
-from .._input.features import merge_detected
-from .stencils import apply_matrix, apply_step, step_matrix
-from .._topology.level import child_creases, child_level, face_parents, plan_step
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
+from .._input import RefineInput, as_data, open_gate
+from .._topology import child_creases, face_parents
+from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
+from .budget import Budget, check_product
+from .loop import Step, walk
+from .linear_uv import linear_uv_matrix
+from .stencils import apply_matrix, step_matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,6 +89,11 @@ class Refinement:
     uv_matrix : scipy.sparse.csr_matrix or None
         With ``uv_faces``: the composite UV matrix (t_L × t), ``UV2 = uv_matrix @ UV``;
         else None.
+    uv_refinement : Refinement or None
+        With ``uv_faces``: the UV index mesh's own refinement (see
+        :func:`hybridsub.refine_face_varying`); else None.
+    max_memory : int, float, str or None
+        The memory limit of the call, which forming ``matrix`` honours too.
     """
 
     faces: np.ndarray
@@ -98,8 +104,9 @@ class Refinement:
     face_parent: np.ndarray
     steps: list
     n_coarse: int
+    max_memory: MemoryLimit = field(default=None, repr=False)  # the limit forming ``matrix`` honours
+    uv_refinement: Refinement | None = field(default=None, repr=False)  # the UV index mesh's, with uv_faces
     _cache: dict = field(default_factory=dict, repr=False)
-    _uv: Refinement | None = field(default=None, repr=False)  # the UV index mesh's refinement
 
     @property
     def n_vertices(self) -> int:
@@ -107,12 +114,12 @@ class Refinement:
 
     @property
     def uv_faces(self) -> np.ndarray | None:
-        return None if self._uv is None else self._uv.faces
+        return None if self.uv_refinement is None else self.uv_refinement.faces
 
     @property
     def uv_matrix(self) -> sp.csr_matrix | None:
         """Composite UV matrix ``S_uv,L ⋯ S_uv,1`` (t_L × t), computed once; None without UVs."""
-        return None if self._uv is None else self._uv.matrix
+        return None if self.uv_refinement is None else self.uv_refinement.matrix
 
     @property
     def matrix(self) -> sp.csr_matrix:
@@ -120,7 +127,7 @@ class Refinement:
         if "matrix" not in self._cache:
             S = sp.identity(self.n_coarse, format="csr", dtype=np.float64)
             for st in self.steps:
-                _budget.check_product(st.matrix, S, self._cache.get("max_memory"))  # size guard
+                check_product(st.matrix, S, self.max_memory)  # size guard
                 S = st.matrix @ S
             S = sp.csr_matrix(S)
             S.sort_indices()
@@ -143,7 +150,7 @@ class Refinement:
         >>> r.apply(V).shape
         (7, 3)
         """
-        A, out_dtype, work = val.as_data(X, self.n_coarse)  # dtypes, shapes, never a view
+        A, out_dtype, work = as_data(X, self.n_coarse)  # dtypes, shapes, never a view
         Y = np.asarray(A, dtype=work).reshape(self.n_coarse, int(np.prod(A.shape[1:], dtype=np.int64)))
         if work == np.complex128:  # real and imaginary parts side by side
             Y = np.concatenate([Y.real, Y.imag], axis=1)
@@ -235,213 +242,92 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     >>> r.faces.shape, r.uv_faces.shape, r.matrix.shape, r.uv_matrix.shape
     ((24, 3), (24, 3), (14, 4), (28, 12))
     """
-    budget = _budget.Budget(val.check_options(scheme, levels, loop_weights), scheme, max_memory)
-    if uv_faces is None and n_uvs is not None:
-        raise ValueError("n_uvs was given without uv_faces")
-    if val.check_non_manifold(non_manifold) == "cut":  # cut, refine the cut mesh, compose
-        return _repair.refine_cut(refine, F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme,
-                                  sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                                  loop_weights=loop_weights, max_memory=max_memory,
-                                  uv=dict(uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode))
-    if uv_faces is not None:  # the face-varying step loop (seams split), in _facevarying
-        from .facevarying import refine_with_uvs
+    inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
+                    max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode)
+    return refinement_of(inp)
 
-        return refine_with_uvs(F, uv_faces, sharp_edges, levels, n_vertices=n_vertices, n_uvs=n_uvs, scheme=scheme,
-                               uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                               loop_weights=loop_weights, max_memory=max_memory)
-    check_uv_mode(uv_mode)
-    levels, Fi, n, pairs, sharp, face_sharp, faces_as_indices, corner = _prepare(
-        F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
 
-    def faces_out(mask):
-        return np.flatnonzero(mask) if faces_as_indices else mask
-
-    corners_out = np.flatnonzero(corner)
-    steps = []
-    face_parent = np.arange(len(Fi), dtype=np.int64)
-    if len(Fi) == 0:  # nothing to refine: every level is the input
-        steps = [RefinementStep(Fi.copy(), sp.identity(n, format="csr"), pairs, sharp, faces_out(face_sharp),
-                                corners_out, face_parent) for _ in range(levels)]
-    for level, plan, faces, child, offsets in _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner,
-                                                    loop_weights, topology_last=True, budget=budget):
-        pairs, sharp = child_creases(level, plan)
-        parent = face_parents(offsets)
+def refinement_of(inp: RefineInput) -> Refinement:
+    """The :class:`Refinement` of a checked input: every step's matrix, faces and tags."""
+    if inp.n_faces == 0:  # nothing to refine: every level is the input
+        return _compose_cut(inp, _unrefined(inp))
+    budget = Budget(inp.levels, inp.scheme, inp.max_memory)
+    corners = np.flatnonzero(inp.corner)
+    uv_corners = np.flatnonzero(inp.uv.corner) if inp.uv is not None else None
+    steps, uv_steps = [], []
+    face_parent = np.arange(inp.n_faces, dtype=np.int64)
+    pairs, sharp, mask = inp.sharp_edges, inp.sharpness, inp.faces_out(inp.face_sharp)
+    uv_pairs, uv_sharp = np.empty((0, 2), np.int64), np.empty(0)
+    for s in walk(inp, budget):
+        parent = face_parents(s.offsets)
         face_parent = face_parent[parent]
-        steps.append(RefinementStep(faces, step_matrix(level, plan), pairs, sharp, faces_out(child.face_sharp),
-                                    corners_out, parent))
-    last = steps[-1] if steps else None
-    r = Refinement(last.faces if last else Fi.copy(), pairs, sharp,
-                   last.sharp_faces if last else faces_out(face_sharp), corners_out, face_parent, steps, n)
-    r._cache["max_memory"] = max_memory  # the composite matrix honours the same limit
-    return r
+        pairs, sharp = child_creases(s.level, s.plan)
+        mask = inp.faces_out(s.child.face_sharp)
+        uv_faces = uv_matrix = None
+        if s.uv is not None:
+            uv_faces, uv_matrix = s.uv.faces, _uv_step_matrix(inp, s)
+            uv_pairs, uv_sharp = child_creases(s.uv.level, s.uv.plan)
+            uv_steps.append(RefinementStep(uv_faces, uv_matrix, uv_pairs, uv_sharp, mask, uv_corners, parent))
+        steps.append(RefinementStep(s.faces, step_matrix(s.level, s.plan), pairs, sharp, mask, corners, parent,
+                                    uv_faces, uv_matrix))
+    uv = None
+    if inp.uv is not None:
+        uv_faces = uv_steps[-1].faces if uv_steps else inp.uv.faces.copy()
+        uv = Refinement(uv_faces, uv_pairs, uv_sharp, mask, uv_corners, face_parent.copy(), uv_steps,
+                        inp.uv.n_uvs, inp.max_memory)
+    faces = steps[-1].faces if steps else inp.faces.copy()
+    r = Refinement(faces, pairs, sharp, mask, corners, face_parent, steps, inp.n_vertices, inp.max_memory, uv)
+    return _compose_cut(inp, r)
 
 
-UV_MODES = ("linear", "smooth")
+def _uv_step_matrix(inp: RefineInput, s: Step) -> sp.csr_matrix:
+    """The UV matrix of one step: the scheme's (``"smooth"``) or linear interpolation."""
+    if inp.uv.mode == "smooth":
+        return step_matrix(s.uv.level, s.uv.plan)
+    return linear_uv_matrix(s.uv.level, s.uv.plan)
 
 
-def check_uv_mode(uv_mode) -> str:
-    if not isinstance(uv_mode, str) or uv_mode not in UV_MODES:
-        raise ValueError(f"uv_mode must be one of {UV_MODES}, got {uv_mode!r}")
-    return uv_mode
+def _unrefined(inp: RefineInput) -> Refinement:
+    """No faces: every level is the input."""
+    n, m = inp.n_vertices, inp.n_faces
+    ident = np.arange(m, dtype=np.int64)
+    mask = inp.faces_out(inp.face_sharp)
+    corners = np.flatnonzero(inp.corner)
+    if inp.uv is None:
+        steps = [RefinementStep(inp.faces.copy(), sp.identity(n, format="csr"), inp.sharp_edges, inp.sharpness,
+                                mask, corners, ident) for _ in range(inp.levels)]
+        faces = steps[-1].faces if steps else inp.faces.copy()
+        return Refinement(faces, inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n, inp.max_memory)
+    T, t = inp.uv.faces, inp.uv.n_uvs
+    no_pairs, no_sharp, no_corners = np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64)
+    steps = [RefinementStep(inp.faces.copy(), sp.identity(n, format="csr"), inp.sharp_edges, inp.sharpness, mask,
+                            corners, ident, T.copy(), sp.identity(t, format="csr")) for _ in range(inp.levels)]
+    uv_steps = [RefinementStep(T.copy(), sp.identity(t, format="csr"), no_pairs, no_sharp, mask, no_corners, ident)
+                for _ in range(inp.levels)]
+    uv = Refinement(T.copy(), no_pairs, no_sharp, mask, no_corners, ident.copy(), uv_steps, t, inp.max_memory)
+    return Refinement(inp.faces.copy(), inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n,
+                      inp.max_memory, uv)
 
 
-def _prepare(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights):
-    """Validate and normalise refine's arguments."""
-    levels = val.check_options(scheme, levels, loop_weights)
-    Fi, n = val.as_faces(F, n_vertices)
-    pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
-    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
-    corner = val.as_corner_mask(corners, n)
-    if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
-        raise ValueError(
-            'scheme="sqrt3" is Kobbelt\'s √3 without feature tags; to keep sharp edges, sharp faces or '
-            'corners use scheme="hybrid" (√3 on smooth faces, Loop on sharp ones)'
-        )
-    if scheme == "loop":
-        face_sharp[:] = True
-    if levels == 0 or len(Fi) == 0:  # topology and tags get the same answer at every level count
-        val.checked_level(Fi, n, pairs)
-    keep = sharp > 0
-    return levels, Fi, n, pairs[keep], sharp[keep], face_sharp, faces_as_indices, corner
+def _compose_cut(inp: RefineInput, r: Refinement) -> Refinement:
+    """With ``non_manifold="cut"``: the cut copy's refinement, taking the caller's vertices.
 
-
-def _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last, budget=None):
-    """Run the steps; yield (level, plan, child faces, child level, child offsets) for each.
-
-    The child level of the last step (its twins and tags) is built only if
-    ``topology_last``. ``budget`` (a ``_budget.Budget``) may refuse before a step allocates.
+    The first step's matrix is composed with the duplication ``D`` (``D[c, v] = 1`` when
+    ``c`` is a copy of ``v``); without steps, the caller's mesh and tags come back as given.
     """
-    if levels == 0 or len(Fi) == 0:
-        return
-    level = val.checked_level(Fi, n, pairs).tag(pairs, sharp, face_sharp)  # named topology errors
-    for step in range(1, levels + 1):
-        plan = plan_step(level, corner, scheme, step, loop_weights)
-        if budget is not None:
-            budget.check(step, level, plan)  # before this step allocates anything large
-        faces, child, offsets = child_level(level, plan, want_topology=topology_last or step < levels)
-        yield level, plan, faces, child, offsets
-        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
-        level = child
-
-
-def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
-              scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-              corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
-              feature_angle: float | None = None, non_manifold: NonManifold = "raise",
-              max_memory: MemoryLimit = None,
-              ) -> tuple[NDArray[np.floating], NDArray[np.int64]] | tuple[NDArray[np.floating], NDArray[np.int64],
-                                                                          sp.csr_matrix]:
-    """Subdivide a triangle mesh, keeping its sharp features.
-
-    Parameters
-    ----------
-    V : (n, 3) array_like of float
-        Vertex positions.
-    F : (m, 3) array_like of int
-        Triangles, consistently oriented, every edge in one or two faces.
-    sharp_edges : (k, 2) array_like of int, optional
-        Crease edges (vertex pairs, either orientation). Boundary edges are creases anyway
-        (``"hybrid"``, ``"loop"``).
-    levels : int
-        Number of subdivision steps.
-    scheme : {"hybrid", "sqrt3", "loop"}
-        ``"hybrid"``: √3 on smooth faces, Loop on sharp faces, creases split and never flipped;
-        ``"sqrt3"``: Kobbelt's √3 with his boundary rule, no tags; ``"loop"``: Loop with creases.
-    sharpness : (k,) array_like of float, optional
-        Sharpness per crease: ``inf`` (default) or ``>= 10`` infinitely sharp, ``0 < s < 10``
-        semi-sharp (``docs/semisharp.md``), ``0`` no crease; negative or NaN is an error.
-    sharp_faces : (m,) bool mask or array_like of int, optional
-        Faces split 1-to-4 by Loop's rule.
-    corners : array_like of int, optional
-        Vertices that never move (vertices with three or more creases are corners anyway).
-    loop_weights : {"loop", "warren"}
-        Smooth vertex weights in Loop regions.
-    return_matrix : bool
-        Also return the composite refinement matrix S (``V2 == S @ V``).
-    feature_angle : float, optional
-        Also tag what :func:`hybridsub.detect_features` finds at this dihedral angle (degrees):
-        its sharp edges (infinitely sharp, unless given in ``sharp_edges``) and corners.
-    non_manifold : {"raise", "cut"}
-        ``"cut"`` cuts the mesh along edges in three or more faces and along inconsistently
-        oriented edges instead of raising; see :func:`refine`.
-    max_memory : int, float or str, optional
-        Memory limit in bytes for this call; see :func:`refine` and ``docs/errors.md``.
-
-    Returns
-    -------
-    V2 : (n', 3) ndarray
-        Refined positions, in the dtype of ``V`` if it is floating-point, else float64 (always
-        computed in float64; a new array, also for ``levels=0``). Vertices no face uses are
-        kept and do not move.
-    F2 : (m', 3) int64 ndarray
-        Refined faces.
-    S : scipy.sparse.csr_matrix, (n', n)
-        Only with ``return_matrix=True``.
-
-    Examples
-    --------
-    >>> import numpy as np, hybridsub
-    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])
-    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
-    >>> V2, F2 = hybridsub.subdivide(V, F, levels=2)
-    >>> V2.shape, F2.shape
-    ((20, 3), (36, 3))
-    >>> V2, F2, S = hybridsub.subdivide(V, F, sharp_edges=[[0, 1]], return_matrix=True)
-    >>> bool(np.allclose(S @ V, V2))
-    True
-    >>> V, F = hybridsub.load_example()
-    >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, feature_angle=30)   # creases found and kept
-    """
-    Vf, out_dtype = val.as_vertices(V, return_dtype=True)
-    if feature_angle is not None:  # automatic features (docs/features.md)
-        sharp_edges, sharpness, corners = merge_detected(Vf, F, feature_angle, sharp_edges, sharpness, corners)
-    if return_matrix or val.check_non_manifold(non_manifold) == "cut":
-        r = refine(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
-                   sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                   non_manifold=non_manifold, max_memory=max_memory)
-        V2 = r.apply(Vf).astype(out_dtype, copy=False)
-        return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
-    last = None
-    for last in subdivide_levels(Vf, F, sharp_edges, levels, scheme=scheme, sharpness=sharpness,
-                                 sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, tags=False,
-                                 max_memory=max_memory):
-        pass
-    if last is None:  # no step ran: copies of the input
-        return Vf.astype(out_dtype, copy=True), val.as_faces(F, len(Vf))[0].copy()
-    return last.X.astype(out_dtype, copy=False), last.faces
-
-
-@dataclass(frozen=True, eq=False)
-class LevelOutput:
-    """One level of :func:`subdivide_levels`."""
-
-    step: int
-    X: np.ndarray  # (n_k, d) refined data
-    faces: np.ndarray  # (m_k, 3)
-    face_parent: np.ndarray | None  # (m_k,) face of the previous level each face came from
-    sharp_edges: np.ndarray | None  # tags of this level (these four None unless tags=True)
-    sharpness: np.ndarray | None
-    sharp_faces: np.ndarray | None  # (m_k,) bool mask
-
-
-def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-                     corners=None, loop_weights="loop", tags=True, max_memory=None):
-    """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
-
-    The fast path behind :func:`subdivide`, for callers that want each level as it is done
-    (the command line's progress bar) or the propagated tags with the positions. ``X`` is
-    any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
-    tags nor face parents are computed (nor the last level's twins). ``max_memory`` as in :func:`subdivide`.
-    """
-    levels, Fi, n, pairs, sharp, face_sharp, _, corner = _prepare(
-        F, sharp_edges, levels, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
-    budget = _budget.Budget(levels, scheme, max_memory, keeps_steps=False)
-    for k, (level, plan, faces, child, offsets) in enumerate(
-            _walk(Fi, n, levels, scheme, pairs, sharp, face_sharp, corner, loop_weights, topology_last=tags,
-                  budget=budget), 1):
-        X = apply_step(level, plan, X)
-        if tags:
-            pairs, sharp = child_creases(level, plan)
-            yield LevelOutput(k, X, faces, face_parents(offsets), pairs, sharp, child.face_sharp)
-        else:
-            yield LevelOutput(k, X, faces, None, None, None, None)
+    if inp.cut is None:
+        return r
+    given = inp.uncut
+    if not r.steps:
+        return dataclasses.replace(r, faces=given.faces.copy(), sharp_edges=given.sharp_edges,
+                                   sharpness=given.sharpness, corners=np.flatnonzero(given.corner),
+                                   n_coarse=given.n_vertices, _cache={})
+    n_cut = inp.n_vertices
+    D = sp.csr_matrix((np.ones(n_cut), inp.cut.origin, np.arange(n_cut + 1)), shape=(n_cut, given.n_vertices))
+    first = r.steps[0]
+    S = sp.csr_matrix(first.matrix @ D)
+    S.sum_duplicates()
+    S.sort_indices()
+    steps = [dataclasses.replace(first, matrix=S)] + list(r.steps[1:])
+    return dataclasses.replace(r, steps=steps, n_coarse=given.n_vertices, _cache={})

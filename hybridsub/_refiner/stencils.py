@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._topology import _kernels as K
-from .._topology.level import Level, StepPlan, step_arguments
+from .._topology import Level, StepPlan, step_arguments
 
 #: Largest index a CSR matrix stores as int32 (above it, int64 indices).
 INT32_LIMIT = np.iinfo(np.int32).max

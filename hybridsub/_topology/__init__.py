@@ -1,11 +1,18 @@
 """Topology and tags (OpenSubdiv's Vtr): halfedges, levels, step plans, emission of the next
-level. Knows connectivity and tags, never positions or weights applied to data. Other
-layers import from here, never from the modules inside."""
+level, the non-manifold cut and the face-varying (UV) index mesh. Knows connectivity and
+tags, never positions. Other layers import from here, never from the modules inside."""
 
+from .cut import Cut, cut_non_manifold, map_sharp_edges
 from .edges import (EdgeGroups, UndirectedEdges, edge_keys, group_halfedges, halfedge_ends, next_halfedge,
                     prev_halfedge, undirected_edges)
-from .level import Level, StepPlan, build_level, child_creases, child_level, face_parents, plan_step, step_arguments
+from .emit import child_creases, child_level, face_parents
+from .errors import duplicate_faces_error, not_an_edge_error, topology_error
+from .level import Level, build_level, checked_level
+from .plan import StepPlan, plan_step, step_arguments
+from .uv import linear_rows, seam_halfedges, uv_start
 
-__all__ = ["EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_level", "child_creases", "child_level",
-           "edge_keys", "face_parents", "group_halfedges", "halfedge_ends", "next_halfedge", "plan_step",
-           "prev_halfedge", "step_arguments", "undirected_edges"]
+__all__ = ["Cut", "EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_level", "checked_level",
+           "child_creases", "child_level", "cut_non_manifold", "duplicate_faces_error", "edge_keys", "face_parents",
+           "group_halfedges", "halfedge_ends", "linear_rows", "map_sharp_edges", "next_halfedge",
+           "not_an_edge_error", "plan_step", "prev_halfedge", "seam_halfedges", "step_arguments", "topology_error",
+           "undirected_edges", "uv_start"]

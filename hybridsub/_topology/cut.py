@@ -17,20 +17,27 @@ The copies then coincide at every level and the pieces stay joined along the cut
 ``"sqrt3"`` takes no tags: each piece follows Kobbelt's boundary rule on its own and the pieces
 separate slightly near the ends of a cut.
 
-The refinement matrices are composed with the duplication (``S_1 @ D``, ``D[c, v] = 1`` when
-``c`` is a copy of ``v``), so ``Refinement.matrix`` and ``apply`` take the caller's vertices.
+The input gate cuts (:func:`hybridsub._input.gate.open_gate`) and the refiner composes the
+first step's matrix with the duplication (``S_1 @ D``, ``D[c, v] = 1`` when ``c`` is a copy
+of ``v``), so ``Refinement.matrix`` and ``apply`` take the caller's vertices.
+
+>>> import numpy as np
+>>> F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])      # edge 0-1 in three faces
+>>> cut = cut_non_manifold(F, 5)
+>>> cut.n_vertices, cut.cut_edges.tolist()
+(9, [[0, 1]])
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .._input import arrays as val
+from .edges import edge_keys, group_halfedges, halfedge_ends, next_halfedge
+from .errors import not_an_edge_error
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,28 +55,6 @@ class Cut:
         return self.origin.shape[0]
 
 
-def _groups(u, w):
-    """Group halfedges by undirected edge: (order, starts, sizes, group of each halfedge).
-
-    ``order`` lists halfedges sorted by (min, max) vertex, ties in halfedge order, so the
-    first of each group is its lowest-numbered halfedge.
-    """
-    lo, hi = np.minimum(u, w), np.maximum(u, w)
-    order = np.lexsort((hi, lo))
-    ls, hs = lo[order], hi[order]
-    new = np.ones(len(order), dtype=bool)
-    new[1:] = (ls[1:] != ls[:-1]) | (hs[1:] != hs[:-1])
-    starts = np.flatnonzero(new)
-    sizes = np.diff(np.append(starts, len(order)))
-    group = np.empty(len(order), np.int64)
-    group[order] = np.cumsum(new) - 1
-    return order, starts, sizes, group
-
-
-def _next_he(h):
-    return h - h % 3 + (h % 3 + 1) % 3
-
-
 def cut_non_manifold(F: np.ndarray, n: int, crease_vertices: np.ndarray | None = None) -> Cut | None:
     """Cut ``F`` (checked (m, 3) int64, no repeated vertex, no duplicate face) along its
     non-manifold and inconsistently oriented edges; ``None`` if there are none.
@@ -80,11 +65,10 @@ def cut_non_manifold(F: np.ndarray, n: int, crease_vertices: np.ndarray | None =
     m = F.shape[0]
     if m == 0:
         return None
-    u = F.ravel()
-    w = F[:, [1, 2, 0]].ravel()
-    order, starts, sizes, group = _groups(u, w)
-    a = order[starts]
-    b = order[np.minimum(starts + 1, len(order) - 1)]
+    u, w = halfedge_ends(F)
+    groups = group_halfedges(u, w)
+    sizes, group = groups.sizes, groups.group
+    a, b = groups.first, groups.second
     proper = (sizes == 2) & (u[a] == w[b])  # two faces, opposite directions
     bad_group = (sizes >= 3) | ((sizes == 2) & ~proper)
     if not bad_group.any():
@@ -95,8 +79,8 @@ def cut_non_manifold(F: np.ndarray, n: int, crease_vertices: np.ndarray | None =
     # Halfedge h = u→w (face f) and its twin t = w→u (face g): u's corners are h and next(t),
     # w's corners are next(h) and t.
     h, t = a[proper], b[proper]
-    links_a = np.concatenate([h, _next_he(h)])
-    links_b = np.concatenate([_next_he(t), t])
+    links_a = np.concatenate([h, next_halfedge(h)])
+    links_b = np.concatenate([next_halfedge(t), t])
     nh = 3 * m
     graph = sp.coo_matrix((np.ones(len(links_a), np.int8), (links_a, links_b)), shape=(nh, nh))
     _, label = connected_components(graph, directed=False)
@@ -142,9 +126,9 @@ def _sharpen(Fc, u, w, first_he, group, he_cut, bad_group, on_cut, origin, n, cr
     n_bad = np.bincount(np.concatenate([u[bad_he], w[bad_he]]), minlength=n)
 
     # boundary edges of the cut mesh, at each copy: how many, and how many are cut edges
-    cu = Fc.ravel()
-    cw = Fc[:, [1, 2, 0]].ravel()
-    _, _, sizes_c, group_c = _groups(cu, cw)
+    cu, cw = halfedge_ends(Fc)
+    cut_groups = group_halfedges(cu, cw)
+    sizes_c, group_c = cut_groups.sizes, cut_groups.group
     boundary_he = sizes_c[group_c] == 1
     ends = np.concatenate([cu[boundary_he], cw[boundary_he]])
     n_boundary = np.bincount(ends, minlength=n_cut)
@@ -172,13 +156,12 @@ def map_sharp_edges(cut: Cut, F: np.ndarray, pairs: np.ndarray, sharp: np.ndarra
     """
     if len(pairs) == 0:
         return pairs.copy(), sharp.copy()
-    u = F.ravel()
-    w = F[:, [1, 2, 0]].ravel()
-    he_key = np.minimum(u, w) * np.int64(n) + np.maximum(u, w)
-    tag_key = np.minimum(pairs[:, 0], pairs[:, 1]) * np.int64(n) + np.maximum(pairs[:, 0], pairs[:, 1])
+    u, w = halfedge_ends(F)
+    he_key = edge_keys(u, w, n)
+    tag_key = edge_keys(pairs[:, 0], pairs[:, 1], n)
     missing = ~np.isin(tag_key, he_key) | (pairs[:, 0] == pairs[:, 1])
     if missing.any():
-        raise val.not_an_edge_error(pairs, np.flatnonzero(missing))
+        raise not_an_edge_error(pairs, np.flatnonzero(missing))
     # the sharpness of each halfedge's edge: the largest given for it
     uk, inv = np.unique(tag_key, return_inverse=True)
     s_key = np.zeros(len(uk))
@@ -186,48 +169,6 @@ def map_sharp_edges(cut: Cut, F: np.ndarray, pairs: np.ndarray, sharp: np.ndarra
     pos = np.searchsorted(uk, he_key)
     pos = np.minimum(pos, len(uk) - 1)
     hit = uk[pos] == he_key
-    cu = cut.faces.ravel()
-    cw = cut.faces[:, [1, 2, 0]].ravel()
+    cu, cw = halfedge_ends(cut.faces)
     return (np.ascontiguousarray(np.stack([cu[hit], cw[hit]], axis=1), dtype=np.int64),
             s_key[pos[hit]])
-
-
-def refine_cut(refine, F, sharp_edges, levels, *, n_vertices, scheme, sharpness, sharp_faces, corners,
-               loop_weights, max_memory, uv):
-    """``refine`` with ``non_manifold="cut"``: cut, refine the cut mesh, compose with the duplication.
-
-    ``uv`` (``uv_faces``, ``n_uvs``, ``uv_mode``) goes to ``refine`` unchanged: the cut keeps
-    the faces and their order, so the UV index mesh is the caller's.
-    """
-    Fi, n = val.as_faces(F, n_vertices)
-    pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
-    corner_in = val.as_corner_mask(corners, n)
-    dup = val.duplicate_faces_error(Fi)
-    if dup is not None:
-        raise dup
-    creased = np.zeros(n, dtype=bool)
-    creased[pairs[sharp > 0].ravel()] = True
-    cut = cut_non_manifold(Fi, n, creased)
-    common = dict(scheme=scheme, sharp_faces=sharp_faces, loop_weights=loop_weights, max_memory=max_memory,
-                  non_manifold="raise", **uv)
-    if cut is None:  # nothing to cut: exactly the plain refinement
-        return refine(Fi, sharp_edges, levels, n_vertices=n, sharpness=sharpness, corners=corners, **common)
-    cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)
-    ccorner = corner_in[cut.origin]
-    if scheme != "sqrt3":  # sqrt3 takes no tags: its pieces follow Kobbelt's boundary rule
-        ccorner = ccorner | cut.corner
-    r = refine(cut.faces, cpairs if sharp_edges is not None else None, levels, n_vertices=cut.n_vertices,
-               sharpness=csharp if sharp_edges is not None else None,
-               corners=np.flatnonzero(ccorner) if ccorner.any() else None, **common)
-    if not r.steps:  # levels == 0: the input itself, as given
-        keep = sharp > 0
-        return dataclasses.replace(r, faces=Fi.copy(), sharp_edges=pairs[keep], sharpness=sharp[keep],
-                                   corners=np.flatnonzero(corner_in), n_coarse=n, _cache={})
-    n_cut = cut.n_vertices
-    D = sp.csr_matrix((np.ones(n_cut), cut.origin, np.arange(n_cut + 1)), shape=(n_cut, n))
-    first = r.steps[0]
-    S = sp.csr_matrix(first.matrix @ D)
-    S.sum_duplicates()
-    S.sort_indices()
-    steps = [dataclasses.replace(first, matrix=S)] + list(r.steps[1:])
-    return dataclasses.replace(r, steps=steps, n_coarse=n, _cache={})

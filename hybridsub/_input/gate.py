@@ -1,0 +1,178 @@
+"""The input gate: one call's mesh, tags and options, checked once and frozen.
+
+Every public entry point that refines (``refine``, ``subdivide``, the face-varying functions,
+the limit functions, the command line through them) passes its arguments through
+:func:`open_gate` and hands the resulting :class:`RefineInput` down; nothing below
+re-validates what the gate checked. The gate converts arrays into fresh ones (the caller's are
+never written to), merges detected features into the tags, cuts a non-manifold mesh when asked
+to, and builds the checked, tagged level 0 (errors name the face, edge or index at fault).
+
+>>> import numpy as np
+>>> inp = open_gate([[0, 1, 2], [0, 2, 3]], levels=2, sharp_edges=[[0, 2]])
+>>> inp.levels, inp.n_vertices, inp.sharp_edges.tolist(), inp.level.n_edges
+(2, 4, [[0, 2]], 5)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._topology import Cut, Level, checked_level, cut_non_manifold, duplicate_faces_error, map_sharp_edges, uv_start
+from . import arrays as val
+from .features import detect_features
+
+
+@dataclass(frozen=True, eq=False)
+class UVInput:
+    """Face-varying data of a call: UV faces aligned row by row with the faces, and the UV
+    index mesh of level 0 (:func:`hybridsub._topology.uv.uv_start`)."""
+
+    faces: np.ndarray  # (m, 3) int64 UV index of each face corner
+    n_uvs: int
+    mode: str  # "linear" or "smooth"
+    level: Level | None = None  # the UV index mesh (None until the geometry's level exists)
+    corner: np.ndarray | None = None  # (t,) bool: UV indices kept as corners
+
+
+@dataclass(frozen=True, eq=False)
+class Uncut:
+    """The caller's mesh and tags, where ``non_manifold="cut"`` refines a cut copy of it."""
+
+    faces: np.ndarray
+    n_vertices: int
+    sharp_edges: np.ndarray
+    sharpness: np.ndarray
+    corner: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class RefineInput:
+    """A checked description of one refinement: what the step loop refines.
+
+    ``faces``, ``n_vertices``, the tags and ``level`` describe the mesh refined: the caller's,
+    or with ``cut`` its cut copy (``uncut`` then keeps the caller's). ``sharp_edges`` holds
+    creases with sharpness > 0 only (normalised: ``inf`` for infinitely sharp);
+    ``face_sharp`` is all True for ``"loop"``.
+    """
+
+    faces: np.ndarray  # (m, 3) int64
+    n_vertices: int
+    levels: int
+    scheme: str
+    loop_weights: str
+    sharp_edges: np.ndarray  # (k, 2) int64
+    sharpness: np.ndarray  # (k,) float64, > 0
+    face_sharp: np.ndarray  # (m,) bool
+    corner: np.ndarray  # (n,) bool
+    faces_as_indices: bool  # the caller gave sharp faces as indices (results give them back so)
+    level: Level  # level 0: checked and tagged
+    max_memory: object
+    uv: UVInput | None = None
+    cut: Cut | None = None
+    uncut: Uncut | None = None
+
+    @property
+    def n_faces(self) -> int:
+        return self.faces.shape[0]
+
+    @property
+    def n_coarse(self) -> int:
+        """Vertices of the caller's mesh (those of the cut copy's refinement matrices' columns)."""
+        return self.uncut.n_vertices if self.uncut is not None else self.n_vertices
+
+    def faces_out(self, mask: np.ndarray) -> np.ndarray:
+        """A sharp-face mask in the form the caller gave sharp faces (mask or indices)."""
+        return np.flatnonzero(mask) if self.faces_as_indices else mask
+
+
+_SQRT3_TAGS = ('scheme="sqrt3" is Kobbelt\'s √3 without feature tags; to keep sharp edges, sharp faces or '
+               'corners use scheme="hybrid" (√3 on smooth faces, Loop on sharp ones)')
+_SQRT3_UV = ('scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every edge, and a flip across a seam '
+             'makes a triangle spanning two UV charts); use scheme="hybrid" (√3 with seams split) or "loop"')
+
+
+def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
+              sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise", max_memory=None,
+              uv_faces=None, n_uvs=None, uv_mode="linear", uv_name="uv_faces", positions=None,
+              feature_angle=None) -> RefineInput:
+    """Check one refinement's arguments (those of :func:`hybridsub.refine`) and describe it.
+
+    ``positions`` ((n, 3) float64, already checked) and ``feature_angle`` add the features
+    :func:`hybridsub.detect_features` finds to the tags; ``uv_name`` is the name errors give
+    the UV faces. Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
+    """
+    levels = val.check_options(scheme, levels, loop_weights)
+    if uv_faces is None and n_uvs is not None:
+        raise ValueError("n_uvs was given without uv_faces")
+    cut_asked = val.check_non_manifold(non_manifold) == "cut"
+    if uv_faces is not None and scheme == "sqrt3":
+        raise ValueError(_SQRT3_UV)
+    val.check_uv_mode(uv_mode)
+    Fi, n = val.as_faces(F, n_vertices)
+    uv = None
+    if uv_faces is not None:
+        n_uvs = val.count(n_uvs, "n_uvs") if n_uvs is not None else None
+        T = val.as_uv_faces(uv_faces, len(Fi), n_uvs, uv_name)
+        uv = UVInput(T, n_uvs if n_uvs is not None else (int(T.max()) + 1 if T.size else 0), uv_mode)
+    pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
+    face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
+    corner = val.as_corner_mask(corners, n)
+    if feature_angle is not None:
+        pairs, sharp = _merge_detected(positions, Fi, feature_angle, pairs, sharp, corner)
+    if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
+        raise ValueError(_SQRT3_TAGS)
+    if scheme == "loop":
+        face_sharp[:] = True
+    common = dict(levels=levels, scheme=scheme, loop_weights=loop_weights, face_sharp=face_sharp,
+                  faces_as_indices=faces_as_indices, max_memory=max_memory)
+    cut = _cut(Fi, n, pairs, sharp) if cut_asked else None
+    if cut is None:
+        keep = sharp > 0
+        level = checked_level(Fi, n, pairs).tag(pairs[keep], sharp[keep], face_sharp)
+        return RefineInput(Fi, n, sharp_edges=pairs[keep], sharpness=sharp[keep], corner=corner, level=level,
+                           uv=_with_uv_level(uv, level, corner), **common)
+    cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)
+    ccorner = corner[cut.origin]
+    if scheme != "sqrt3":  # sqrt3 takes no tags: its pieces follow Kobbelt's boundary rule
+        ccorner = ccorner | cut.corner
+    keep, kept = csharp > 0, sharp > 0
+    level = checked_level(cut.faces, cut.n_vertices, cpairs).tag(cpairs[keep], csharp[keep], face_sharp)
+    return RefineInput(cut.faces, cut.n_vertices, sharp_edges=cpairs[keep], sharpness=csharp[keep],
+                       corner=ccorner, level=level, uv=_with_uv_level(uv, level, ccorner), cut=cut,
+                       uncut=Uncut(Fi, n, pairs[kept], sharp[kept], corner), **common)
+
+
+def _with_uv_level(uv: UVInput | None, level: Level, corner: np.ndarray) -> UVInput | None:
+    if uv is None or level.n_faces == 0:
+        return uv
+    uvl, uv_corner = uv_start(level, uv.faces, uv.n_uvs, corner)
+    return UVInput(uv.faces, uv.n_uvs, uv.mode, uvl, uv_corner)
+
+
+def _cut(Fi: np.ndarray, n: int, pairs: np.ndarray, sharp: np.ndarray) -> Cut | None:
+    """The non-manifold cut of ``Fi``, or None when there is nothing to cut."""
+    dup = duplicate_faces_error(Fi)
+    if dup is not None:
+        raise dup
+    creased = np.zeros(n, dtype=bool)
+    creased[pairs[sharp > 0].ravel()] = True
+    return cut_non_manifold(Fi, n, creased)
+
+
+def _merge_detected(V, Fi, angle, pairs, sharp, corner):
+    """Add the features detected at ``angle`` to checked tags (the caller's take precedence).
+
+    Detected sharp edges the caller already tagged keep the caller's sharpness; the others
+    are infinitely sharp. Detected corners are set in ``corner`` (a fresh mask, in place).
+    """
+    feat = detect_features(V, Fi, angle)
+    n = len(V)
+    found = feat.sharp_edges
+    if len(pairs):
+        key = np.sort(pairs, axis=1) @ np.array([n, 1], dtype=np.int64)
+        fkey = np.sort(found, axis=1) @ np.array([n, 1], dtype=np.int64)
+        found = found[~np.isin(fkey, key)]
+    corner[feat.corners] = True
+    return np.concatenate([pairs, found]), np.concatenate([sharp, np.full(len(found), np.inf)])

@@ -1,0 +1,83 @@
+"""The step loop: the one place that runs steps, for every way of refining.
+
+:func:`walk` takes a :class:`~hybridsub._input.gate.RefineInput` and yields one :class:`Step`
+per level: the level and its plan, the faces of the next level and the next level itself. It
+carries the optional face-varying (UV) channel beside the geometry: each step plans the
+geometry with seams as forced splits, then the UV index mesh with the geometry's split edges
+as forced splits, so both make the same decisions and emit aligned faces. What a step yields
+is turned into matrices (:mod:`.refinement`) or applied to data directly (:mod:`.fastpath`).
+
+>>> from hybridsub._input.gate import open_gate
+>>> [len(s.faces) for s in walk(open_gate([[0, 1, 2], [0, 2, 3]], levels=2))]
+[10, 38]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import NamedTuple
+
+import numpy as np
+
+from .._input.gate import RefineInput
+from .._rules import refinement as R
+from .._topology import Level, StepPlan, child_level, plan_step
+from .budget import Budget
+
+
+class UVStep(NamedTuple):
+    """The UV index mesh's part of a step."""
+
+    level: Level  # UV index mesh of level k, and its plan
+    plan: StepPlan
+    faces: np.ndarray  # UV faces of level k + 1, aligned with the geometry's
+    child: Level  # UV index mesh of level k + 1
+
+
+class Step(NamedTuple):
+    """One step of :func:`walk`: level k → k + 1."""
+
+    step: int  # 1-based
+    level: Level  # level k, and its plan
+    plan: StepPlan
+    faces: np.ndarray  # faces of level k + 1
+    child: Level | None  # level k + 1 (None for the last step unless asked for)
+    offsets: np.ndarray  # (m + 1,) child offsets of the faces of level k
+    uv: UVStep | None  # with face-varying data
+
+
+def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = True) -> Iterator[Step]:
+    """Run ``inp.levels`` steps; yield a :class:`Step` for each (none without faces).
+
+    The next level's twins and tags are built for the last step only if ``topology_last``
+    (always with face-varying data). ``budget`` may refuse before the first step allocates.
+    """
+    if inp.levels == 0 or inp.n_faces == 0:
+        return
+    level, corner = inp.level, inp.corner
+    uvl = uv_fixed = None
+    if inp.uv is not None:
+        uvl, uv_fixed = inp.uv.level, inp.uv.corner
+    for step in range(1, inp.levels + 1):
+        if uvl is None:
+            plan = plan_step(level, corner, inp.scheme, step, inp.loop_weights)
+            if budget is not None:
+                budget.check(step, level, plan)  # before this step allocates anything large
+            faces, child, offsets = child_level(level, plan, want_topology=topology_last or step < inp.levels)
+            yield Step(step, level, plan, faces, child, offsets, None)
+        else:
+            seams = (uvl.twin < 0) & (level.twin >= 0)  # the UV mesh is cut exactly along the seams
+            plan = plan_step(level, corner, inp.scheme, step, inp.loop_weights, force_split=seams)
+            uv_plan = plan_step(uvl, uv_fixed, inp.scheme, step, inp.loop_weights,
+                                force_split=plan.hkind == R.EDGE_SPLIT)
+            if not np.array_equal(uv_plan.hkind, plan.hkind):
+                raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
+            if budget is not None:
+                budget.check(step, level, plan, also=(uvl, uv_plan))
+            faces, child, offsets = child_level(level, plan)
+            uv_faces, uv_child, _ = child_level(uvl, uv_plan)
+            yield Step(step, level, plan, faces, child, offsets, UVStep(uvl, uv_plan, uv_faces, uv_child))
+            uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
+            uvl = uv_child
+        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
+        level = child

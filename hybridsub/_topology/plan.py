@@ -1,0 +1,94 @@
+"""One step's plan: every decision a step makes from topology and tags (edge kinds, the
+layout of the new points, every vertex mask as four coefficients), before any weight is
+applied to data.
+
+>>> import numpy as np
+>>> from hybridsub._topology.level import checked_level
+>>> level = checked_level(np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]), 4)
+>>> plan = plan_step(level, np.zeros(4, bool), "sqrt3", 1, "loop")
+>>> plan.n_new      # four old vertices and one face point per face
+8
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._rules import refinement as R
+from . import _kernels as K
+from .level import Level
+
+
+#: Empty arrays handed to kernels in place of an absent input.
+EMPTY_FLOAT = np.empty(0, np.float64)
+EMPTY_INT = np.empty(0, np.int64)
+EMPTY_BOOL = np.empty(0, np.bool_)
+
+
+@dataclass(frozen=True, eq=False)
+class StepPlan:
+    """Everything one step decides from topology and tags, before any weight is applied."""
+
+    scheme: str
+    step: int  # 1-based within the call; only "sqrt3" cares (Kobbelt's odd/even boundary)
+    hkind: np.ndarray  # (3m,) int8 EDGE_* code of each halfedge's edge
+    edge_point: np.ndarray  # (3m,) index of the (first) new point on each halfedge's edge, −1 if none
+    face_point: np.ndarray  # (m,) index of the face point, −1 if none
+    trisected: np.ndarray  # (m,) int8 local index of the trisected boundary halfedge, −1 if none
+    coefficients: np.ndarray  # (4, n): every vertex mask, see _rules.vertex_mask
+    n_new: int
+    bnext: np.ndarray  # (3m,) boundary links, only filled for Kobbelt's even steps
+    bprev: np.ndarray
+
+
+def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_weights: str,
+              force_split: np.ndarray | None = None) -> StepPlan:
+    """Classify edges and vertices of one step and lay out the new points.
+
+    ``force_split`` (3m,) bool marks halfedges whose edges are split even between smooth
+    faces (UV seams: R4 points, no flip); both halfedges of an edge must agree.
+
+    Tags come from the level (``hsharp``, ``face_sharp``: all sharp for ``"loop"``, none for
+    ``"sqrt3"``); ``corner`` (n,) is the corner mask.
+    """
+    F, twin = level.faces, level.twin
+    m, n = level.n_faces, level.n_vertices
+    odd = step % 2 == 1
+    sqrt3 = scheme == "sqrt3"
+    has_tags = level.hsharp is not None and not sqrt3
+    hkind = np.empty(3 * m, np.int8)
+    edge_point = np.empty(3 * m, np.int64)
+    face_point = np.empty(m, np.int64)
+    trisected = np.empty(m, np.int8)
+    counts = np.zeros((6, n), np.int64)
+    s_frac = np.zeros(n, np.float64)
+    if force_split is not None and sqrt3:
+        raise ValueError('scheme="sqrt3" flips every interior edge; forced splits need "hybrid" or "loop"')
+    force = EMPTY_BOOL if force_split is None else np.ascontiguousarray(force_split, dtype=bool)
+    n_sharp = int(np.count_nonzero(level.face_sharp))
+    mixed = 0 < n_sharp < m
+    region_of_all = -1 if mixed else (R.REGION_LOOP if n_sharp else R.REGION_SQRT3)
+    n_new = K.classify_step(F, twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, level.face_sharp, mixed,
+                            force, R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts,
+                            s_frac)
+    table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
+    cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
+    coefficients = np.empty((4, n), np.float64)
+    K.vertex_coefficients(counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
+    if sqrt3 and not odd:
+        bnext, bprev = K.boundary_links(F, twin)
+    else:
+        bnext = bprev = EMPTY_INT
+    return StepPlan(scheme, step, hkind, edge_point, face_point, trisected, coefficients, int(n_new), bnext,
+                    bprev)
+
+
+def step_arguments(level: Level, plan: StepPlan) -> tuple:
+    """The arguments the stencil kernels share, in their order."""
+    has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
+    return (level.faces, level.twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, plan.hkind,
+            plan.edge_point, plan.face_point, plan.coefficients, plan.bnext, plan.bprev)
+
+

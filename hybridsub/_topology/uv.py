@@ -1,0 +1,94 @@
+"""The face-varying (UV) index mesh of a level: seams, the UV level on the geometry's
+halfedges, the UV indices kept as corners, and the UV edges and faces of linear new values.
+
+Textures come as per-corner indices ``T (m, 3)``, aligned face by face with the faces. A
+*seam* is an interior edge whose two faces disagree on the UV indices at its ends. The UV
+index mesh is a :class:`~hybridsub._topology.level.Level` with the geometry's halfedges and
+twins cut along seams, so its boundary is the mesh boundary plus both sides of every seam;
+it is built from the geometry's adjacency, never from UV indices alone (a UV index pair that
+recurs elsewhere does not glue faces). See ``docs/face_varying.md``.
+
+>>> import numpy as np
+>>> from hybridsub._topology.level import checked_level
+>>> level = checked_level(np.array([[0, 1, 2], [0, 2, 3]]), 4)
+>>> seam_halfedges(level, np.array([[0, 1, 2], [3, 4, 5]])).nonzero()[0].tolist()
+[2, 3]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .edges import next_halfedge
+from .level import Level
+
+
+def seam_halfedges(level: Level, T: np.ndarray) -> np.ndarray:
+    """(3m,) bool: interior halfedges whose face and twin face disagree on a UV index."""
+    twin = level.twin
+    h = np.flatnonzero(twin >= 0)
+    g = twin[h]
+    o = T.ravel()
+    nxt = next_halfedge(h)
+    gnxt = next_halfedge(g)
+    seam = np.zeros(len(twin), dtype=bool)
+    seam[h] = (o[h] != o[gnxt]) | (o[nxt] != o[g])
+    return seam
+
+
+def uv_level(level: Level, T: np.ndarray, t: int) -> Level:
+    """The UV index mesh as a Level on the geometry's halfedges, twins cut along seams, with
+    the geometry's tags (a tag on a seam is moot: seams are UV boundary, creases anyway)."""
+    twin = np.where(seam_halfedges(level, T), -1, level.twin)
+    return Level(np.ascontiguousarray(T, dtype=np.int64), int(t), twin, level.hsharp, level.face_sharp)
+
+
+def irregular_uv(level: Level, uvl: Level) -> np.ndarray:
+    """(t,) bool: UV indices that cannot be one smooth value, kept as UV corners.
+
+    A UV index used by several separate face sectors around a vertex (more than one UV
+    boundary halfedge leaves it), by several geometric vertices (which includes a face
+    repeating a UV index), or at a vertex where several fans meet (a bow-tie, a corner of the
+    geometry; OpenSubdiv sharpens every face-varying value there too).
+    """
+    t, n = uvl.n_vertices, max(level.n_vertices, 1)
+    o = uvl.faces.ravel()
+    fv = level.faces.ravel()
+    uv_fans = np.bincount(o[uvl.twin < 0], minlength=t)
+    pairs = np.unique(o * np.int64(n) + fv)
+    users = np.bincount(pairs // n, minlength=t)
+    bowtie = np.bincount(fv[level.twin < 0], minlength=level.n_vertices) > 1
+    out = (uv_fans > 1) | (users > 1)
+    out[o[bowtie[fv]]] = True
+    return out
+
+
+def carried_corners(level: Level, uvl: Level, corner: np.ndarray) -> np.ndarray:
+    """(t,) bool: UV indices at tagged corner vertices."""
+    out = np.zeros(uvl.n_vertices, dtype=bool)
+    out[uvl.faces.ravel()[corner[level.faces.ravel()]]] = True
+    return out
+
+
+def linear_rows(uvl: Level, plan) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The UV edges (k, 2) and UV faces (l, 3) of ``uv_mode="linear"``'s new values, in
+    ``plan``'s layout (old values, then edge points, then face points), each row sorted; and
+    whether one repeats a UV index (a degenerate UV edge or face)."""
+    t = uvl.n_vertices
+    h = np.flatnonzero(plan.edge_point >= 0)
+    h = h[(uvl.twin[h] < 0) | (h < uvl.twin[h])]  # one halfedge per split edge
+    fv = uvl.faces.ravel()
+    E = np.empty((len(h), 2), np.int64)
+    E[plan.edge_point[h] - t] = np.sort(np.stack([fv[h], fv[next_halfedge(h)]], axis=1), axis=1)
+    f = np.flatnonzero(plan.face_point >= 0)
+    T = np.empty((len(f), 3), np.int64)
+    T[plan.face_point[f] - t - len(h)] = np.sort(uvl.faces[f], axis=1)
+    return E, T, bool((E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any())
+
+
+def uv_start(level: Level, T: np.ndarray, t: int, corner: np.ndarray) -> tuple[Level, np.ndarray]:
+    """The UV index mesh of level 0 and its UV corner mask (t,): carried corner tags and
+    irregular UV indices. Both keep their status from level to level, and new UV values are
+    neither (each lies on one new vertex, in one sector)."""
+    uvl = uv_level(level, T, t)
+    return uvl, carried_corners(level, uvl, corner) | irregular_uv(level, uvl)
