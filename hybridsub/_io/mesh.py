@@ -136,7 +136,13 @@ def color_bytes(colors: np.ndarray) -> np.ndarray:
 
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
               vertex_colors=None, uv=None, face_uv=None) -> TaggedMesh:
-    """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays)."""
+    """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays; creases of
+    sharpness 0 left out, masks turned into indices, integer colours scaled to [0, 1]).
+
+    >>> m = as_tagged(np.eye(3), [[0, 1, 2]], corners=[False, True, False])
+    >>> m.corners.tolist(), m.sharp_edges.shape
+    ([1], (0, 2))
+    """
     V = as_vertices(vertices)
     F, _ = as_faces(faces, len(V))
     E, s = as_sharp_edges(sharp_edges, sharpness, len(V))

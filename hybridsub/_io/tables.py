@@ -11,7 +11,13 @@ from .._errors import MeshError
 
 
 def triangulate_polygons(path: str, polys: list, triangulate: bool, what: str = "face"):
-    """Triangles of a list of index lists; returns (faces, origin face of each triangle)."""
+    """Triangles of a list of index lists (fans, if ``triangulate``); returns (faces, polygon
+    of each triangle), the second None where every polygon is a triangle.
+
+    >>> F, origin = triangulate_polygons("q.obj", [[0, 1, 2, 3]], True)
+    >>> F.tolist(), origin.tolist()
+    ([[0, 1, 2], [0, 2, 3]], [0, 0])
+    """
     sizes = np.fromiter((len(p) for p in polys), np.int64, len(polys))
     if len(polys) and (sizes == 3).all():
         return np.array(polys, dtype=np.int64).reshape(-1, 3), None
@@ -53,7 +59,11 @@ def check_faces(path: str, F: np.ndarray, n: int, origin: np.ndarray | None) -> 
 
 
 def text_rows(prefix: str, A: np.ndarray, fmt: str) -> list[str]:
-    """Format rows of A as text lines, in chunks (one % per chunk is fast in CPython)."""
+    """Format rows of A as text lines, in chunks (one % per chunk is fast in CPython).
+
+    >>> text_rows("f ", np.array([[1, 2, 3]]), "%d")
+    ['f 1 2 3\\n']
+    """
     if A.size == 0:
         return []
     row = prefix + " ".join([fmt] * (A.shape[1] // fmt.count("%"))) + "\n"
