@@ -1,9 +1,22 @@
 """Mesh files: the data model (:class:`TaggedMesh`), one module per format, welding and tag
-lists. Other layers import from here, never from the modules inside."""
+lists. Other layers import from here, never from the modules inside.
 
-from .examples import example_path, load_example, read_off
-from .mesh import (TaggedMesh, classes, describe_tags, read_edge_file, read_list_file, read_mesh, weld, write,
-                   write_mesh)
+mesh.py           TaggedMesh, as_tagged, describe_tags, the tag conventions of files
+formats.py        read_mesh / write_mesh / write: the format by the file's extension
+obj.py, ply.py, off.py, npz.py, trimesh_formats.py: one module per format (off.py also
+                  read_off, the examples' plain loader)
+tables.py         polygons read as triangles, index checks, rows written as text
+weld.py           classes, weld
+tagfiles.py       the command line's tag lists (read_edge_file, read_list_file)
+examples.py       the shipped example meshes (example_path, load_example)
+"""
+
+from .examples import example_path, load_example
+from .formats import read_mesh, write, write_mesh
+from .mesh import TaggedMesh, describe_tags
+from .off import read_off
+from .tagfiles import read_edge_file, read_list_file
+from .weld import classes, weld
 
 __all__ = ["TaggedMesh", "classes", "describe_tags", "example_path", "load_example", "read_edge_file",
            "read_list_file", "read_mesh", "read_off", "weld", "write", "write_mesh"]

@@ -1,4 +1,5 @@
-"""PLY reading and writing (ASCII and binary), keeping vertex order and extra elements.
+"""PLY files: reading and writing elements (ASCII and binary), keeping vertex order and extra
+elements, and PLY meshes with their tag elements.
 
 trimesh's PLY loader unmerges vertices when faces carry texture coordinates and turns an
 ``edge`` element into a path, so hybridsub reads PLY itself: tags refer to vertex indices and
@@ -14,6 +15,9 @@ from typing import Any
 import numpy as np
 
 from .._errors import MeshError
+from .._version import __version__
+from .mesh import INFINITE, TaggedMesh, color_bytes, sharpness_from_file, sharpness_to_file
+from .tables import check_faces, triangulate_polygons
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -266,3 +270,154 @@ def _write_ascii_rows(fh, props) -> None:
     for s in range(0, len(rows), chunk):
         block = rows[s:s + chunk]
         fh.write(((row * len(block)) % tuple(v for r in block for v in r)).encode("ascii"))
+
+
+# ----------------------------------------------------------------------------------------------
+# meshes
+
+def read_ply_mesh(path: str, triangulate: bool) -> TaggedMesh:
+    """Read a PLY mesh with its ``crease`` (or ``edge``), ``corner`` and ``sharp_face``
+    elements (see :func:`hybridsub.read_mesh`).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "t.ply")
+    >>> write_ply_mesh(path, TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), corners=np.array([1])), binary=True)
+    >>> m = read_ply_mesh(path, False)
+    >>> m.faces.tolist(), m.corners.tolist()
+    ([[0, 1, 2]], [1])
+    """
+    el = read_ply(path)
+    V, colors = _ply_vertices(path, el)
+    n = len(V)
+    fd = el["face"].data if "face" in el else {}
+    key = next((k for k in ("vertex_indices", "vertex_index") if k in fd), None)
+    if key is None:
+        raise MeshError(f"{path}: not a triangle mesh (no 'face' element with vertex_indices)")
+    idx = fd[key]
+    polys = idx if isinstance(idx, list) else np.asarray(idx)
+    if isinstance(polys, np.ndarray) and polys.ndim == 2 and polys.shape[1] == 3:
+        F, origin = polys.astype(np.int64), None
+    else:
+        F, origin = triangulate_polygons(path, [list(map(int, p)) for p in polys], triangulate)
+    check_faces(path, F, n, origin)
+    uv, face_uv = _ply_uv(el["vertex"].data, fd, F, origin)
+    notes = [f"triangulated {len(polys)} polygons into {len(F)} triangles"] if origin is not None else []
+    E, s = _ply_creases(path, el, n)
+    C = _ply_corners(path, el, n)
+    S = _ply_sharp_faces(path, el, len(polys), origin)
+    return TaggedMesh(np.ascontiguousarray(V), np.ascontiguousarray(F), E, s, C, S, colors, uv, face_uv,
+                      tuple(notes))
+
+
+def _ply_vertices(path: str, el: dict[str, _Element]) -> tuple[np.ndarray, np.ndarray | None]:
+    """Positions and colours (or None) of the ``vertex`` element."""
+    if "vertex" not in el:
+        raise MeshError(f"{path}: the PLY file has no 'vertex' element")
+    vd = el["vertex"].data
+    if not all(k in vd for k in "xyz"):
+        raise MeshError(f"{path}: the PLY 'vertex' element has no x, y, z properties")
+    V = np.column_stack([np.asarray(vd[k], dtype=np.float64) for k in "xyz"]).reshape(-1, 3)
+    colors = None
+    if all(k in vd for k in ("red", "green", "blue")):
+        cols = [vd[k] for k in ("red", "green", "blue", "alpha") if k in vd]
+        scale = 255.0 if np.asarray(cols[0]).dtype.kind in "iu" else 1.0
+        colors = np.column_stack(cols).astype(np.float64) / scale
+    return V, colors
+
+
+def _ply_uv(vd: dict, fd: dict, F: np.ndarray, origin: np.ndarray | None):
+    """(uv, face_uv): per vertex (s/t, u/v or texture_u/texture_v), or per face corner
+    (``texcoord`` lists of six), or (None, None)."""
+    names = next(((a, b) for a, b in (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
+                  if a in vd and b in vd), None)
+    if names:
+        return np.column_stack([np.asarray(vd[k], dtype=np.float64) for k in names]), F.copy()
+    if "texcoord" in fd and origin is None and np.ndim(fd["texcoord"]) == 2 and np.shape(fd["texcoord"])[1] == 6:
+        uv = np.asarray(fd["texcoord"], dtype=np.float64).reshape(-1, 2)
+        return uv, np.arange(len(uv), dtype=np.int64).reshape(-1, 3)
+    return None, None
+
+
+def _ply_creases(path: str, el: dict[str, _Element], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Crease pairs and sharpness of the ``crease`` (or ``edge``) element; sharpness <= 0 left out."""
+    tag = "crease" if "crease" in el else "edge" if "edge" in el else None
+    if not tag:
+        return np.empty((0, 2), np.int64), np.empty(0)
+    ed = el[tag].data
+    if not ("vertex1" in ed and "vertex2" in ed):
+        raise MeshError(f"{path}: the PLY '{tag}' element needs vertex1 and vertex2 properties")
+    E = np.column_stack([np.asarray(ed["vertex1"]), np.asarray(ed["vertex2"])]).astype(np.int64).reshape(-1, 2)
+    sk = next((k for k in ("crease", "sharpness") if k in ed), None)
+    s = np.asarray(ed[sk], dtype=np.float64) if sk else np.full(len(E), np.inf)
+    bad = ((E < 0) | (E >= n)).any(axis=1)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"{path}: {tag} {j} names vertices {E[j].tolist()}, but there are {n} vertices")
+    keep = s > 0
+    return E[keep], sharpness_from_file(s[keep])
+
+
+def _ply_corners(path: str, el: dict[str, _Element], n: int) -> np.ndarray:
+    """Sorted corner vertices of the ``corner`` element (those of sharpness <= 0 left out)."""
+    if "corner" not in el:
+        return np.empty(0, np.int64)
+    cd = el["corner"].data
+    ck = next((k for k in ("vertex", "vertex_index") if k in cd), None)
+    if ck is None:
+        raise MeshError(f"{path}: the PLY 'corner' element needs a 'vertex' property")
+    C = np.asarray(cd[ck], dtype=np.int64)
+    if "sharpness" in cd:
+        C = C[np.asarray(cd["sharpness"]) > 0]
+    if ((C < 0) | (C >= n)).any():
+        raise MeshError(f"{path}: a corner names vertex {int(C[(C < 0) | (C >= n)][0])}, but there are {n}")
+    return np.unique(C)
+
+
+def _ply_sharp_faces(path: str, el: dict[str, _Element], nf: int, origin: np.ndarray | None) -> np.ndarray:
+    """Sharp faces of the ``sharp_face`` element, as triangles (``origin``: polygon of each)."""
+    if "sharp_face" not in el:
+        return np.empty(0, np.int64)
+    S = np.asarray(el["sharp_face"].data.get("face", np.empty(0)), dtype=np.int64)
+    if ((S < 0) | (S >= nf)).any():
+        raise MeshError(f"{path}: a sharp_face names face {int(S[(S < 0) | (S >= nf)][0])}, but there are {nf}")
+    return np.flatnonzero(np.isin(origin, S)) if origin is not None else np.unique(S)
+
+
+def write_ply_mesh(path: str, m: TaggedMesh, binary: bool) -> None:
+    """Write ``m`` as PLY (binary little-endian or ASCII) with ``crease`` (vertex1, vertex2,
+    sharpness; 10 = infinitely sharp), ``corner`` and ``sharp_face`` elements.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "t.ply")
+    >>> write_ply_mesh(path, TaggedMesh(np.eye(3), np.array([[0, 1, 2]])), binary=False)
+    >>> open(path).read().splitlines()[-2:]
+    ['0.0 0.0 1.0', '3 0 1 2']
+    """
+    vertex = [("x", "f8", m.vertices[:, 0]), ("y", "f8", m.vertices[:, 1]), ("z", "f8", m.vertices[:, 2])]
+    if m.vertex_colors is not None:
+        c = color_bytes(m.vertex_colors)
+        vertex += [(k, "u1", c[:, i]) for i, k in enumerate(("red", "green", "blue", "alpha")[:c.shape[1]])]
+    face = [("vertex_indices", "i4", m.faces.astype(np.int32))]
+    vuv = m.vertex_uv
+    if vuv is not None:
+        vertex += [("s", "f4", vuv[:, 0]), ("t", "f4", vuv[:, 1])]
+    elif m.uv is not None:
+        face.append(("texcoord", "f4", m.uv[m.face_uv].reshape(-1, 6)))
+    elements = [("vertex", vertex), ("face", face)]
+    if len(m.sharp_edges):
+        # Not named "edge": trimesh turns an 'edge' element into a path and fails on extra properties.
+        elements.append(("crease", [("vertex1", "i4", m.sharp_edges[:, 0]), ("vertex2", "i4", m.sharp_edges[:, 1]),
+                                    ("sharpness", "f8", sharpness_to_file(m.sharpness))]))
+    if len(m.corners):
+        elements.append(("corner", [("vertex", "i4", m.corners), ("sharpness", "f8",
+                                                                 np.full(len(m.corners), INFINITE))]))
+    if len(m.sharp_faces):
+        elements.append(("sharp_face", [("face", "i4", m.sharp_faces)]))
+    write_ply(path, elements, binary=binary, comments=(
+        f"hybridsub {__version__}",
+        "crease: 0-based vertex1 vertex2 and sharpness (10 = infinitely sharp); corner: vertex, sharpness",
+    ))
