@@ -15,7 +15,7 @@ Collections (written as OBJ into a temporary folder):
 For each collection, output format and worker count: a fresh ``LocalCluster`` (its start is
 timed on its own), one untimed warm-up batch on two meshes (each worker imports hybridsub and
 loads the Numba cache), then ``hybridsub.batch`` into an empty folder, timed. The baseline
-runs the same per-mesh function (``_cli.subdivide_file``, what each task runs) in a loop in
+runs the same per-mesh function (``pipeline.subdivide_file``, what each task runs) in a loop in
 this process, without Dask. Needs the ``batch`` extra (Dask).
 """
 
@@ -33,8 +33,9 @@ import numpy as np
 from _bench import DATA, cpu_name
 
 import hybridsub
-from hybridsub._app.batch import MANIFEST, local_cluster
-from hybridsub._app.cli import subdivide_file
+from hybridsub._app.batch import local_cluster
+from hybridsub._app.manifest import MANIFEST
+from hybridsub._app.pipeline import FileOptions, subdivide_file
 
 
 def gear(teeth: int, layers: int, rng) -> tuple[np.ndarray, np.ndarray]:
@@ -106,9 +107,7 @@ def input_faces(folder: str) -> tuple[int, int]:
 def baseline(folder: str, outdir: str, fmt: str, levels: int) -> tuple[float, int, dict]:
     """The per-mesh function of a batch task in a loop here: seconds, output faces, and the
     sums of its read, refine and write times."""
-    a = argparse.Namespace(levels=levels, scheme="hybrid", feature_angle=30.0, loop_weights="loop",
-                           ignore_tags=False, triangulate=False, weld=False, sharp_edges=None, sharp_faces=None,
-                           corners=None, quiet=True, no_tags=False, ascii=False, force=False)
+    a = FileOptions(levels=levels, scheme="hybrid", feature_angle=30.0, loop_weights="loop", quiet=True)
     files = sorted(os.path.join(r, f) for r, _, fs in os.walk(folder) for f in fs)
     subdivide_file(a, files[0], os.path.join(outdir, f"warm.{fmt}"))  # Numba's cache, as a worker's first task
     t = time.perf_counter()

@@ -21,7 +21,7 @@ from distributed import KilledWorker
 import hybridsub
 from conftest import DATA
 from hybridsub._app import batch as _batch
-from hybridsub._app.batch import MANIFEST, TMPDIR, Manifest, assign_outputs, expand_inputs
+from hybridsub._app.manifest import MANIFEST, TMPDIR, Manifest, assign_outputs, expand_inputs
 from hybridsub._app.cli import main
 from hybridsub._app.progress import BatchProgress
 from strategies import grid, sphere_hull, torus
@@ -573,21 +573,19 @@ def test_progress_bar_and_killed_worker_record():
     BatchProgress(10, enabled=False, stream=off).update(3, 0, 10, 1.0)
     assert off.getvalue() == ""
     job = {"input": "/x.obj", "options": {}, "options_key": "k", "hybridsub": "0", "output": "x.obj", "reason": "new"}
-    rec = _batch._failed_on_cluster(job, KilledWorker("key", SimpleNamespace(address="tcp://w"), 3), KilledWorker)
+    rec = _batch.failed_on_cluster(job, KilledWorker("key", SimpleNamespace(address="tcp://w"), 3), KilledWorker)
     assert rec["status"] == "failed" and rec["error"].startswith("/x.obj: the worker running it died")
 
 
 def test_run_task_records_what_went_wrong(tmp_path, monkeypatch):
     """The task never raises: another hybridsub version on the worker, and a bug (with its
     traceback), become failed records, and no temporary file stays behind."""
-    from hybridsub._app import cli as _cli
-
     src = tmp_path / "t.off"
     src.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
     os.makedirs(tmp_path / "tmp")
     job = {"input": str(src), "output": "t.obj", "output_path": str(tmp_path / "out" / "t.obj"),
-           "tmpdir": str(tmp_path / "tmp"), "options": _batch._options(1, "hybrid", None, None, "loop", "obj", False,
-                                                                      False, False, None),
+           "tmpdir": str(tmp_path / "tmp"), "options": _batch.batch_options(1, "hybrid", None, None, "loop", "obj",
+                                                                           False, False, False, None),
            "options_key": "k", "hybridsub": "0.0.1", "force": False, "reason": "new", "verify": None}
     rec = _batch.run_task(job)
     assert rec["status"] == "failed" and "this worker has hybridsub" in rec["error"] and "0.0.1" in rec["error"]
@@ -597,7 +595,7 @@ def test_run_task_records_what_went_wrong(tmp_path, monkeypatch):
             fh.write("half a file")
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(_cli, "subdivide_file", broken)
+    monkeypatch.setattr(_batch, "subdivide_file", broken)
     rec = _batch.run_task(dict(job, hybridsub=hybridsub.__version__))
     assert rec["status"] == "failed" and rec["error"] == f"{src}: internal error: RuntimeError: boom"
     assert "Traceback" in rec["traceback"] and os.listdir(tmp_path / "tmp") == []

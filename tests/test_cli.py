@@ -1,7 +1,6 @@
 """The command line end to end (subprocesses), its pieces in-process, and the engines behind it:
 level counts (info), level-by-level refinement (progress), the renderer (compare)."""
 
-import argparse
 import json
 import os
 import subprocess
@@ -14,7 +13,8 @@ import hybridsub
 from conftest import DATA, load_mesh
 from hybridsub import read_mesh
 from hybridsub._app.cli import main
-from hybridsub._app.report import mesh_report, predict_levels
+from hybridsub._app.report import mesh_report
+from hybridsub._refiner import predict_levels
 from hybridsub._app.progress import ProgressBar, refine_by_level
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -292,18 +292,19 @@ def test_info(capsys):
 
 
 def test_memory_guard(tmp_path, capsys, monkeypatch):
-    import hybridsub._app.cli as cli
+    from hybridsub._app import pipeline
+    from hybridsub._app.pipeline import FileOptions
 
-    monkeypatch.setattr(cli, "_ram_bytes", lambda: 50_000_000)
+    monkeypatch.setattr(pipeline, "physical_memory", lambda: 50_000_000)
     assert main(["subdivide", off("cube-meshed"), "-o", str(tmp_path / "x.obj"), "--levels", "6"]) == 1
     err = capsys.readouterr().err
     assert "would need about" in err and "this machine has 50.0 MB" in err and "--force" in err
     # a batch task checks against its Dask worker's memory limit where that is smaller
     pred = [{"peak_bytes": 30_000_000, "faces": 1000}]
-    with pytest.raises(cli.CLIError, match="the Dask worker's memory limit is 20.0 MB"):
-        cli._check_memory(argparse.Namespace(force=False, memory_limit=20_000_000), pred, "3 levels")
-    cli._check_memory(argparse.Namespace(force=False, memory_limit=90_000_000), pred, "3 levels")  # RAM: 50 MB
-    cli._check_memory(argparse.Namespace(force=True, memory_limit=20_000_000), pred, "3 levels")
+    with pytest.raises(pipeline.PipelineError, match="the Dask worker's memory limit is 20.0 MB"):
+        pipeline.check_memory(FileOptions(force=False, memory_limit=20_000_000), pred, "3 levels")
+    pipeline.check_memory(FileOptions(force=False, memory_limit=90_000_000), pred, "3 levels")  # RAM: 50 MB
+    pipeline.check_memory(FileOptions(force=True, memory_limit=20_000_000), pred, "3 levels")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -490,7 +491,7 @@ def test_textured_obj_with_sqrt3_and_other_formats(tmp_path, capsys):
 def test_textured_counts_are_predicted():
     """The counts info and the progress bar use include the split seams: exact with UVs, and
     without them (compare) the plain refinement's."""
-    from hybridsub._app.cli import Features, _predict
+    from hybridsub._app.pipeline import FileFeatures as Features, predict_file_levels as _predict
 
     d = np.load(os.path.join(DATA, "bunny10k_textured.fvar_linear.L1.npz"))
     m = hybridsub.TaggedMesh(d["V_in"], d["F_in"], uv=d["UV_in"], face_uv=d["FUV_in"])

@@ -2,23 +2,20 @@
 
 One task per mesh. The client expands the inputs, decides which are already done (the
 manifest), and sends each task a few paths and the options; the worker reads the input,
-runs the ``subdivide`` command's own code on it (``_cli.subdivide_file``, so outputs equal
-``hybridsub subdivide``'s byte for byte), writes the output under a temporary name, renames
-it, and sends back a small record. The client alone appends records to the manifest. The
-decisions (names, the manifest, resuming, exit codes) are in ``docs/batch.md``.
+runs the file pipeline on it (:func:`~hybridsub._app.pipeline.subdivide_file`, the code of
+``hybridsub subdivide``, so outputs equal the command's byte for byte), writes the output
+under a temporary name, renames it, and sends back a small record. The client alone appends
+records to the manifest (``manifest.py``). The decisions (names, the manifest, resuming, exit
+codes) are in ``docs/batch.md``.
 """
 
 from __future__ import annotations
 
-import argparse
 import datetime
-import glob
 import hashlib
-import json
 import logging
 import math
 import os
-import re
 import time
 import traceback
 import uuid
@@ -26,19 +23,18 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from .._errors import MeshError
+from .._input import check_options, count_of
 from .._rules.refinement import normalize_sharpness
 from .._typing import LoopWeights, Scheme
-from .._input import check_options
+from .._units import si
+from .._version import __version__
+from .manifest import TMPDIR, Manifest, assign_outputs, clean_tmpdir, expand_inputs, options_key, plan_item
+from .pipeline import FileOptions, PipelineError, subdivide_file
 
 __all__ = ["batch", "BatchSummary"]
 
 FORMATS = ("obj", "ply", "npz")
-MANIFEST = "hybridsub-manifest.jsonl"
-TMPDIR = ".hybridsub-tmp"
-#: Extensions a directory or a pattern picks up (files named one by one may have any).
-MESH_EXTENSIONS = (".obj", ".ply", ".off", ".npz", ".stl", ".glb", ".gltf", ".3mf", ".dae")
 INSTALL_HINT = "python -m pip install 'hybridsub[batch]'"
-_MAGIC = re.compile(r"[*?[]")
 _CHUNK = 1 << 20
 
 
@@ -111,7 +107,7 @@ class BatchSummary:
         """The final table ``hybridsub batch`` prints, failures listed (at most ``max_failures``)."""
         rate = ""
         if self.seconds > 0 and self.done:
-            rate = f"   {self.done / self.seconds:.1f} meshes/s, {_si(self.output_faces / self.seconds)} faces/s"
+            rate = f"   {self.done / self.seconds:.1f} meshes/s, {si(self.output_faces / self.seconds)} faces/s"
         where = f" on {self.cluster}" if self.cluster else ""
         lines = [f"hybridsub batch: {self.total:,} meshes → {self.outdir}{where}",
                  f"  done       {self.done:>8,}   {self.output_faces:,} output faces",
@@ -131,189 +127,6 @@ class BatchSummary:
 
     def __str__(self) -> str:
         return self.table()
-
-
-def _si(x: float) -> str:
-    for unit, div in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
-        if x >= div:
-            return f"{x / div:.1f} {unit}"
-    return f"{x:.0f}"
-
-
-# ----------------------------------------------------------------------------------------------
-# inputs and output names
-
-
-@dataclass(frozen=True)
-class _Input:
-    path: str  # absolute
-    stem: str  # output name without extension, relative to OUTDIR, '/'-separated
-
-
-def _within(path: str, folder: str) -> bool:
-    return os.path.commonpath([path, folder]) == folder
-
-
-def expand_inputs(inputs: Iterable[str | os.PathLike], outdir: str) -> tuple[list[_Input], int]:
-    """Files of the INPUTS in order (directories walked, patterns expanded, both sorted), each
-    once, with its output stem: a file's base name, or the path below the directory or the
-    pattern's fixed folder. ``outdir`` is not walked, and files a pattern finds in it are left
-    out (returns how many); an INPUT inside it is an error."""
-    real_out = os.path.realpath(outdir)
-    seen: set[str] = set()
-    found: list[_Input] = []
-    left_out = 0
-    if isinstance(inputs, (str, os.PathLike)):
-        inputs = [inputs]
-    for arg in inputs:
-        arg = os.fspath(arg)
-        if os.path.exists(arg) and _within(os.path.realpath(arg), real_out):
-            raise ValueError(f"{arg}: the input lies inside the output folder {outdir}; write to another folder")
-        if _MAGIC.search(arg) and not os.path.exists(arg):
-            parts = arg.replace(os.sep, "/").split("/")
-            fixed = "/".join(parts[:next(i for i, p in enumerate(parts) if _MAGIC.search(p))])
-            base = fixed if fixed else "."
-            if arg.startswith("/") and not fixed:
-                base = "/"
-            files = sorted(f for f in glob.glob(arg, recursive=True)
-                           if os.path.isfile(f) and f.lower().endswith(MESH_EXTENSIONS))
-            if not files:
-                raise FileNotFoundError(f"the pattern {arg!r} matches no mesh file ({', '.join(MESH_EXTENSIONS)})")
-            kept = [f for f in files if not _within(os.path.realpath(f), real_out)]
-            if not kept:
-                raise ValueError(f"the pattern {arg!r} matches only files inside the output folder {outdir}; "
-                                 "write to another folder")
-            left_out += len(files) - len(kept)
-            files = kept
-        elif os.path.isdir(arg):
-            base = arg
-            files = []
-            for root, dirs, names in os.walk(arg):
-                dirs[:] = sorted(d for d in dirs if not _within(os.path.realpath(os.path.join(root, d)), real_out))
-                files += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(MESH_EXTENSIONS)]
-            if not files:
-                raise FileNotFoundError(f"{arg}: the folder holds no mesh file ({', '.join(MESH_EXTENSIONS)})")
-        elif os.path.exists(arg):
-            base, files = os.path.dirname(arg) or ".", [arg]
-        else:
-            raise FileNotFoundError(f"{arg}: no such file or directory")
-        for f in files:
-            path = os.path.abspath(f)
-            if path in seen:
-                continue
-            seen.add(path)
-            rel = os.path.relpath(f, base).replace(os.sep, "/")
-            if rel.startswith("../") or rel == "..":
-                rel = os.path.basename(f)
-            found.append(_Input(path, os.path.splitext(rel)[0]))
-    return found, left_out
-
-
-def assign_outputs(items: list[_Input], fmt: str, owners: dict[str, str], previous: dict[str, str]) -> list[str]:
-    """Output names (relative to OUTDIR) for ``items``, never two alike (compared without
-    case). An input keeps the name the manifest gave it before (``previous``: input → output);
-    a new input takes ``STEM.FMT`` unless another input has it, in this run or in the manifest
-    (``owners``: casefolded name → input), and then ``STEM-HASH.FMT``, HASH from its path."""
-    taken = dict(owners)
-    names: list[str | None] = [None] * len(items)
-
-    def free(name: str, path: str) -> bool:
-        return taken.get(name.casefold(), path) == path
-
-    for i, it in enumerate(items):
-        prev = previous.get(it.path)
-        if prev is not None:
-            name = f"{os.path.splitext(prev)[0]}.{fmt}"
-            if free(name, it.path):
-                names[i] = name
-                taken[name.casefold()] = it.path
-    for i, it in enumerate(items):
-        if names[i] is not None:
-            continue
-        name = f"{it.stem}.{fmt}"
-        digest = hashlib.sha1(it.path.encode("utf-8", "surrogateescape")).hexdigest()
-        for width in (8, 16, 40):
-            if free(name, it.path):
-                break
-            name = f"{it.stem}-{digest[:width]}.{fmt}"
-        names[i] = name
-        taken[name.casefold()] = it.path
-    return names
-
-
-# ----------------------------------------------------------------------------------------------
-# the manifest
-
-
-class Manifest:
-    """``OUTDIR/hybridsub-manifest.jsonl``, locked while a batch runs. Reading keeps the last
-    record of each (input, options key); a torn last line (a killed writer) is cut off, other
-    unreadable lines are skipped. ``append`` writes whole lines and fsyncs."""
-
-    def __init__(self, outdir: str):
-        self.path = os.path.join(outdir, MANIFEST)
-        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_APPEND, 0o644)
-        try:
-            self._lock()
-            self.notes: list[str] = []
-            self.records: dict[tuple[str, str], dict] = {}
-            self._read()
-        except BaseException:
-            os.close(self.fd)
-            raise
-
-    def _lock(self) -> None:
-        try:
-            import fcntl
-        except ImportError:  # Windows: no advisory locks; one batch per folder is then up to the user
-            return
-        try:
-            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise RuntimeError(f"{self.path} is locked: another hybridsub batch is writing to this folder; "
-                               "wait for it, or use another output folder") from None
-
-    def _read(self) -> None:
-        with open(self.path, "rb") as fh:
-            data = fh.read()
-        end = data.rfind(b"\n") + 1
-        if end < len(data):  # a line without its newline: the writer was killed in the middle of it
-            os.ftruncate(self.fd, end)
-            self.notes.append(f"cut off a torn last line of {MANIFEST} ({len(data) - end} bytes)")
-            data = data[:end]
-        bad = 0
-        for line in data.splitlines():
-            try:
-                rec = json.loads(line)
-                key = (rec["input"], rec["options_key"])
-            except (ValueError, KeyError, TypeError):
-                bad += line.strip() != b""
-                continue
-            self.records[key] = rec
-        if bad:
-            self.notes.append(f"skipped {bad} unreadable lines of {MANIFEST}")
-
-    def owners(self) -> tuple[dict[str, str], dict[str, str]]:
-        """Casefolded output name → input, and input → its latest output name."""
-        owners, previous = {}, {}
-        for (path, _), rec in self.records.items():
-            out = rec.get("output")
-            if isinstance(out, str):
-                owners[out.casefold()] = path
-                previous[path] = out
-        return owners, previous
-
-    def append(self, records: list[dict]) -> None:
-        if not records:
-            return
-        data = b"".join(json.dumps(r, ensure_ascii=False, allow_nan=False).encode() + b"\n" for r in records)
-        view = memoryview(data)
-        while view:
-            view = view[os.write(self.fd, view):]
-        os.fsync(self.fd)
-
-    def close(self) -> None:
-        os.close(self.fd)  # releases the lock
 
 
 # ----------------------------------------------------------------------------------------------
@@ -348,9 +161,6 @@ def _worker_settings() -> tuple[str, int | None]:
 def run_task(job: dict) -> dict:
     """Subdivide one file: the worker's side of a batch. Never raises for a bad mesh: the
     record says ``"status": "failed"`` and why."""
-    from .._version import __version__
-    from .cli import CLIError, subdivide_file
-
     t0 = time.perf_counter()
     src, dst = job["input"], job["output_path"]
     rec = {"input": src, "input_size": None, "input_mtime_ns": None, "input_sha256": None,
@@ -362,7 +172,7 @@ def run_task(job: dict) -> dict:
     try:
         rec["worker"], memory_limit = _worker_settings()
         if __version__ != job["hybridsub"]:
-            raise CLIError(f"this worker has hybridsub {__version__}, the client {job['hybridsub']}: install the "
+            raise PipelineError(f"this worker has hybridsub {__version__}, the client {job['hybridsub']}: install the "
                            "same version everywhere")
         st = os.stat(src)
         rec["input_size"], rec["input_mtime_ns"] = st.st_size, st.st_mtime_ns
@@ -374,17 +184,16 @@ def run_task(job: dict) -> dict:
                 rec["status"] = "skipped"
                 return rec
             rec["reason"] = why
-        a = argparse.Namespace(**job["options"], sharp_edges=None, sharp_faces=None, corners=None, quiet=True,
-                               no_tags=False, ascii=False, force=job["force"], memory_limit=memory_limit)
         tmp = os.path.join(job["tmpdir"], f"{uuid.uuid4().hex}.{job['options']['format']}")
-        res = subdivide_file(a, src, dst, write_to=tmp)
+        res = subdivide_file(file_options(job["options"], force=job["force"], memory_limit=memory_limit), src, dst,
+                             write_to=tmp)
         t = time.perf_counter()
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         rec["output_sha256"] = _sha256(tmp)
         rec["output_size"] = os.path.getsize(tmp)
         if os.stat(src).st_mtime_ns != st.st_mtime_ns:
-            raise CLIError(f"{src}: the file changed while it was being read")
+            raise PipelineError(f"{src}: the file changed while it was being read")
         os.makedirs(os.path.dirname(dst), exist_ok=True)
         os.replace(tmp, dst)
         tmp = None
@@ -392,7 +201,7 @@ def run_task(job: dict) -> dict:
                    features=res.features, notes=res.notes)
         rec["seconds"] = {"read": round(res.seconds_read, 6), "refine": round(res.seconds_refine, 6),
                           "write": round(res.seconds_write + time.perf_counter() - t, 6)}
-    except (CLIError, MeshError, ValueError, TypeError) as e:
+    except (PipelineError, MeshError, ValueError, TypeError) as e:
         rec["error"] = str(e)
     except OSError as e:
         rec["error"] = f"{e.filename}: {e.strerror}" if e.filename and e.strerror else str(e)
@@ -425,8 +234,9 @@ def _verify(rec: dict, expect: dict, dst: str) -> str | None:
 # the client
 
 
-def _options(levels, scheme, feature_angle, feature_sharpness, loop_weights, fmt, ignore_tags, triangulate, weld,
-             uv_mode) -> dict:
+def batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights, fmt, ignore_tags, triangulate,
+                  weld, uv_mode) -> dict:
+    """The options of a batch, checked, as the manifest records them (and its key hashes them)."""
     levels = check_options(scheme, levels, loop_weights)
     if fmt not in FORMATS:
         raise ValueError(f"format must be one of {FORMATS}, got {fmt!r}")
@@ -453,46 +263,11 @@ def _options(levels, scheme, feature_angle, feature_sharpness, loop_weights, fmt
             "ignore_tags": bool(ignore_tags), "triangulate": bool(triangulate), "weld": bool(weld), "uv_mode": uv_mode}
 
 
-def options_key(options: dict, version: str) -> str:
-    """What makes two runs' outputs of one input the same: the options and hybridsub's version."""
-    text = json.dumps(dict(options, hybridsub=version), sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
-
-def _plan(item: _Input, output: str, outdir: str, prev: dict | None, seen_input: bool, verify: bool):
-    """(skip, reason): whether ``item`` is done already, and why it must run otherwise."""
-    if prev is None:
-        return False, "options changed" if seen_input else "new"
-    if prev.get("status") != "done":
-        return False, "failed before"
-    try:
-        st = os.stat(item.path)
-    except OSError:
-        return False, "input changed"
-    if (st.st_size, st.st_mtime_ns) != (prev.get("input_size"), prev.get("input_mtime_ns")):
-        return False, "input changed"
-    if prev.get("output") != output:
-        return False, "output name changed"
-    try:
-        size = os.path.getsize(os.path.join(outdir, output))
-    except OSError:
-        return False, "output missing"
-    if size != prev.get("output_size"):
-        return False, "output changed"
-    return not verify, "verify"  # skip, or have a worker compare checksums
-
-
-def _clean_tmpdir(tmpdir: str) -> int:
-    """Remove what killed tasks left in OUTDIR/.hybridsub-tmp; returns how many files."""
-    removed = 0
-    for entry in os.scandir(tmpdir):
-        if entry.is_file(follow_symlinks=False):
-            try:
-                os.remove(entry.path)
-                removed += 1
-            except FileNotFoundError:  # a task of an earlier, orphaned run finishing right now
-                pass
-    return removed
+def file_options(options: dict, **changes) -> FileOptions:
+    """The pipeline's options of one task: the batch's ``options`` (the format aside: it is the
+    output's extension), no messages, and ``changes``."""
+    return FileOptions(**{k: v for k, v in options.items() if k != "format"}, quiet=True, **changes)
 
 
 def _default_workers() -> int:
@@ -534,7 +309,7 @@ def _connect(scheduler, workers: int | None, quiet: bool):
         return client, [client], f"the scheduler at {scheduler}"
     n = _default_workers() if workers is None else workers
     cluster, client = local_cluster(n, quiet=quiet)
-    return client, [client, cluster], f"a local cluster of {n} worker{'s' if n > 1 else ''}"
+    return client, [client, cluster], f"a local cluster of {count_of(n, 'worker')}"
 
 
 def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str | os.PathLike, *, levels: int = 3,
@@ -612,11 +387,10 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
     >>> s.done, s.failed, sorted(os.listdir(os.path.join(d, "out")))
     (1, 0, ['fandisk.obj', 'hybridsub-manifest.jsonl'])
     """
-    from .._version import __version__
     from .progress import BatchProgress
 
     t_start = time.perf_counter()
-    options = _options(levels, scheme, feature_angle, feature_sharpness, loop_weights, format, ignore_tags,
+    options = batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights, format, ignore_tags,
                        triangulate, weld, uv_mode)
     key = options_key(options, __version__)
     outdir = os.path.abspath(os.fspath(outdir))
@@ -640,7 +414,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
             notes.append(f"left out {left_out:,} files inside the output folder")
         tmpdir = os.path.join(outdir, TMPDIR)
         os.makedirs(tmpdir, exist_ok=True)
-        stray = _clean_tmpdir(tmpdir)
+        stray = clean_tmpdir(tmpdir)
         if stray:
             notes.append(f"removed {stray} temporary files left by an interrupted run")
         owners, previous = manifest.owners()
@@ -649,7 +423,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
         jobs, skipped = [], 0
         for item, name in zip(items, names):
             prev = manifest.records.get((item.path, key))
-            skip, reason = _plan(item, name, outdir, prev, item.path in seen_inputs, verify)
+            skip, reason = plan_item(item, name, outdir, prev, item.path in seen_inputs, verify)
             if skip:
                 skipped += 1
                 continue
@@ -715,7 +489,7 @@ def _run(client, jobs: list[dict], manifest: Manifest, summary: BatchSummary, ba
                                        "scheduler was lost, or the scheduler restarted; what finished is in "
                                        f"{manifest.path}: run again to finish") from None
                 except Exception as e:  # run_task never raises: this came from the cluster
-                    rec = _failed_on_cluster(job, e, KilledWorker)
+                    rec = failed_on_cluster(job, e, KilledWorker)
                 fut.release()
                 rec["run"] = run_id
                 rec["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="milliseconds")
@@ -742,7 +516,7 @@ def _run(client, jobs: list[dict], manifest: Manifest, summary: BatchSummary, ba
         ac.clear()
 
 
-def _failed_on_cluster(job: dict, exc: BaseException, killed_worker: type) -> dict:
+def failed_on_cluster(job: dict, exc: BaseException, killed_worker: type) -> dict:
     """The record of a task that raised on the cluster (run_task itself never raises)."""
     if isinstance(exc, killed_worker):
         why = (f"{job['input']}: the worker running it died each time it was tried ({exc}); "

@@ -11,7 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import render as _render
+from .._input import count_of
 from .._refiner import refine
+from .._topology import undirected_edges
 
 SCHEME_TITLES = {"sqrt3": "Kobbelt √3", "hybrid": "hybrid √3–Loop", "loop": "Loop"}
 
@@ -30,11 +32,9 @@ def compare_panels(V, F, levels: int, *, sharp_edges=None, sharpness=None, sharp
                    loop_weights="loop") -> list[Panel]:
     """Subdivide with the three schemes; the input panel shows creases (red: infinitely
     sharp, orange: semi-sharp) and boundary edges."""
-    from .report import _edges
-
     E = np.empty((0, 2), np.int64) if sharp_edges is None else np.asarray(sharp_edges, dtype=np.int64).reshape(-1, 2)
     s = np.full(len(E), np.inf) if sharpness is None else np.asarray(sharpness, dtype=np.float64)
-    pairs, _, cnt = _edges(np.asarray(F, dtype=np.int64), len(V))
+    pairs, _, cnt = undirected_edges(np.asarray(F, dtype=np.int64), len(V))
     boundary = pairs[cnt == 1]
     n_sharp = len(E)
     caption = f"{len(F):,} faces · {n_sharp:,} sharp edges"
@@ -45,7 +45,7 @@ def compare_panels(V, F, levels: int, *, sharp_edges=None, sharpness=None, sharp
         tags = {} if scheme == "sqrt3" else dict(sharpness=sharpness, sharp_faces=sharp_faces, corners=corners)
         r = refine(F, None if scheme == "sqrt3" else sharp_edges, levels, n_vertices=len(V), scheme=scheme,
                    loop_weights=loop_weights, **tags)
-        panels.append(Panel(f"{SCHEME_TITLES[scheme]}, {levels} level{'s' if levels != 1 else ''}",
+        panels.append(Panel(f"{SCHEME_TITLES[scheme]}, {count_of(levels, 'level')}",
                             r.apply(V), r.faces, f"{len(r.faces):,} faces"))
     return panels
 

@@ -1,7 +1,7 @@
 """Refinement level by level, with a progress bar on stderr.
 
-The command line refines with :func:`hybridsub._refine.subdivide_levels`, the fast path of
-``subdivide`` (or, for a mesh with UVs, ``_facevarying.subdivide_face_varying_levels``),
+The file pipeline refines with :func:`hybridsub._refiner.subdivide_levels`, the fast path of
+``subdivide`` (or, for a mesh with UVs, ``subdivide_face_varying_levels``),
 which yields each level as it is done with its propagated tags: the bar moves per level,
 only two levels are held at a time, and no matrix is formed.
 """
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._refiner import subdivide_face_varying_levels
-from .._refiner import subdivide_levels
+from .._refiner import subdivide_face_varying_levels, subdivide_levels
+from .._units import si
 
 
 @dataclass
@@ -82,13 +82,6 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
                        face_uv)
 
 
-def _si(x: float) -> str:
-    for unit, div in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
-        if x >= div:
-            return f"{x / div:.1f} {unit}"
-    return f"{x:.0f}"
-
-
 class _StatusLine:
     """One line on a stream (stderr), redrawn in place: a label, a bar, a percentage and text."""
 
@@ -131,7 +124,7 @@ class ProgressBar(_StatusLine):
         if not self.enabled:
             return
         rate = n_faces / seconds if seconds > 0 else float("inf")
-        info = f"level {done}/{levels}: {n_faces:,} faces, {_si(rate)} faces/s"
+        info = f"level {done}/{levels}: {n_faces:,} faces, {si(rate)} faces/s"
         if done < levels:
             nxt = int(self.cum[min(done + 1, self.levels)] - self.cum[done])
             info += f"; next {nxt:,}"
@@ -162,5 +155,5 @@ class BatchProgress(_StatusLine):
         if failed:
             info += f" ({failed:,} failed)"
         if seconds > 0:
-            info += f", {_si(faces / seconds)} faces/s"
+            info += f", {si(faces / seconds)} faces/s"
         self.draw((finished + failed) / self.total if self.total else 1.0, info)

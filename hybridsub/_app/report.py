@@ -1,22 +1,8 @@
-"""What a mesh is made of, and what subdividing it will produce — from counts alone.
+"""What a mesh is made of: ``mesh_report``, the counts and defects ``hybridsub info`` prints.
 
-``mesh_report`` describes a mesh without assuming it is valid (it is what ``hybridsub info``
-prints, so it must survive non-manifold edges and bad orientation). ``predict_levels`` gives
-the exact face, vertex and edge counts of every level from the classes of SCHEME.md, without
-refining anything, and a memory estimate from those counts.
-
-Counting rules (exact for any valid input; ``tests/test_cli.py`` checks them against ``refine``):
-- every edge lies in one or two faces, so ``E = (3F + B) / 2`` at every level (B: boundary
-  edges), and the Euler characteristic ``V − E + F`` never changes; hence ``V`` follows from
-  ``F`` and ``B``;
-- ``"loop"``: ``F ← 4F``, ``B ← 2B``;
-- ``"sqrt3"``: ``F ← 3F``; ``B`` is unchanged in odd steps and trisected (``B ← 3B``) in even ones;
-- ``"hybrid"``: a sharp face makes 4 sharp faces, a smooth face ``3 + s`` smooth faces (``s``
-  split edges). A split halfedge of a smooth face has two split children in two smooth faces
-  while its edge stays split: for ever on a boundary or next to a sharp face, ``⌈σ⌉`` levels
-  for a crease of sharpness ``σ`` between smooth faces. So with ``Fs, Fh`` smooth and sharp
-  faces and ``σ_h`` the sharpness of each split halfedge of a smooth face at level 0,
-  ``H_k = Σ_h 2^k [σ_h > k]``, ``Fs ← 3Fs + H_k``, ``Fh ← 4Fh``, ``B ← 2B``.
+It describes a mesh without assuming it is valid, so it must survive non-manifold edges and
+bad orientation. What subdividing will produce comes from the refiner
+(:func:`hybridsub._refiner.predict_levels`).
 """
 
 from __future__ import annotations
@@ -25,25 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .._rules import refinement as R
-
-#: Bytes per face of one step's topology tables and classification (halfedge twins, edge
-#: numbering, vertex→edge incidence, step plan). Measured as the peak RSS of
-#: ``refine(F, levels=1)`` + ``apply`` minus everything else ``predict_levels`` counts:
-#: 175–210 bytes per face on armadillo (L1, L2 inputs; hybrid, loop, sqrt3) and fandisk L3.
-TOPOLOGY_BYTES_PER_FACE = 200
-
-
-def _edges(F: np.ndarray, n: int):
-    """Undirected edges of the halfedges of F: (pairs (E, 2), edge of each halfedge (3m,),
-    halfedge count per edge (E,))."""
-    u = F.ravel()
-    w = F[:, [1, 2, 0]].ravel()
-    lo, hi = np.minimum(u, w), np.maximum(u, w)
-    key = lo.astype(np.int64) * max(n, 1) + hi
-    uniq, first, inv, cnt = np.unique(key, return_index=True, return_inverse=True, return_counts=True)
-    pairs = np.stack([lo[first], hi[first]], axis=1)
-    return pairs, inv.ravel(), cnt
+from .._topology import undirected_edges
 
 
 def mesh_report(V: np.ndarray, F: np.ndarray) -> dict:
@@ -56,7 +24,7 @@ def mesh_report(V: np.ndarray, F: np.ndarray) -> dict:
     orientable manifold; else None), valence histogram {valence: count}, bbox (2, 3).
     """
     n, m = len(V), len(F)
-    pairs, eid, cnt = _edges(F, n)
+    pairs, eid, cnt = undirected_edges(F, n)
     ne = len(pairs)
     used = np.zeros(n, bool)
     used[F.ravel()] = True
@@ -116,93 +84,3 @@ def mesh_report(V: np.ndarray, F: np.ndarray) -> dict:
         "valence": hist,
         "bbox": np.array([V[used].min(axis=0), V[used].max(axis=0)]) if n_used else np.zeros((2, 3)),
     }
-
-
-def predict_levels(F: np.ndarray, n_vertices: int, levels: int, *, scheme: str = "hybrid", sharp_edges=None,
-                   sharpness=None, sharp_faces=None, attributes: int = 3) -> list[dict]:
-    """Exact counts of every level of ``subdivide``, and a memory estimate, from level 0 alone.
-
-    Parameters
-    ----------
-    F : (m, 3) int64
-        A valid mesh's faces (every edge in one or two faces).
-    n_vertices, levels, scheme, sharp_edges, sharpness, sharp_faces
-        As for ``refine``; ``sharp_faces`` as a boolean mask or indices.
-    attributes : int
-        Floats per vertex being refined (3 for positions, more with colours or UVs).
-
-    Returns
-    -------
-    list of dict, one per level 1..levels
-        ``faces``, ``vertices``, ``edges``, ``boundary_edges``, ``nnz`` (an upper bound of the
-        step matrix's non-zeros), ``output_bytes`` (positions and faces, float64/int64) and
-        ``peak_bytes`` (estimated peak working memory of that step, as ``hybridsub subdivide``
-        runs it: the previous level, the step's tables and matrix, and the new level).
-    """
-    F = np.asarray(F, dtype=np.int64)
-    m0 = len(F)
-    pairs, eid, cnt = _edges(F, n_vertices)
-    E = len(pairs)
-    B = int((cnt == 1).sum())
-    Fh = Fs = 0
-    H = np.empty(0)
-    if scheme == "loop":
-        Fh = m0
-    elif scheme == "hybrid":
-        sharp = np.zeros(m0, bool)
-        if sharp_faces is not None:
-            sf = np.asarray(sharp_faces)
-            if sf.dtype == bool:
-                sharp |= sf
-            else:
-                sharp[sf.astype(np.int64)] = True
-        Fh, Fs = int(sharp.sum()), int((~sharp).sum())
-        es = np.zeros(E)
-        if sharp_edges is not None and len(sharp_edges):
-            se = np.asarray(sharp_edges, dtype=np.int64).reshape(-1, 2)
-            s = (np.full(len(se), np.inf) if sharpness is None
-                 else R.normalize_sharpness(np.asarray(sharpness, dtype=np.float64)))
-            key = se.min(axis=1) * max(n_vertices, 1) + se.max(axis=1)
-            ekey = pairs[:, 0] * max(n_vertices, 1) + pairs[:, 1]
-            pos = np.searchsorted(ekey, key)
-            ok = (pos < E) & (ekey[np.minimum(pos, E - 1)] == key)
-            np.maximum.at(es, pos[ok], s[ok])
-        es[cnt == 1] = np.inf
-        # for each halfedge, is the other face on its edge sharp?
-        order = np.argsort(eid, kind="stable")
-        other_sharp = np.zeros(3 * m0, bool)
-        two = cnt[eid[order]] == 2
-        h1, h2 = order[two][0::2], order[two][1::2]
-        other_sharp[h1] = sharp[h2 // 3]
-        other_sharp[h2] = sharp[h1 // 3]
-        hs = np.where(other_sharp, np.inf, es[eid])
-        H = hs[~np.repeat(sharp, 3) & (hs > 0)]
-    out = []
-    n, m = n_vertices, m0
-    for k in range(levels):
-        step = k + 1
-        if scheme == "loop":
-            m2, B2, face_points = 4 * m, 2 * B, 0
-        elif scheme == "sqrt3":
-            odd = step % 2 == 1
-            m2, B2 = 3 * m, (B if odd else 3 * B)
-            face_points = m if odd else m - B
-        else:
-            Hk = int(np.sum(np.where(H > k, 2.0 ** k, 0.0)))
-            Fs2, Fh2 = 3 * Fs + Hk, 4 * Fh
-            m2, B2, face_points = Fs2 + Fh2, 2 * B, Fs
-            Fs, Fh = Fs2, Fh2
-        E2 = (3 * m2 + B2) // 2
-        n2 = n + (E2 - E) - (m2 - m)
-        split_points = n2 - n - face_points
-        nnz = n + 2 * E + 4 * split_points + 3 * face_points
-        out_bytes = 8 * attributes * n2 + 24 * m2
-        peak = (8 * attributes * n + 24 * m  # the level being refined
-                + TOPOLOGY_BYTES_PER_FACE * m  # its tables and the step plan
-                + 12 * nnz + 8 * (n2 + 1)  # the step matrix (CSR)
-                + out_bytes + 8 * m2)  # the new level and its face parents
-        out.append({"level": step, "faces": int(m2), "vertices": int(n2), "edges": int(E2),
-                    "boundary_edges": int(B2), "nnz": int(nnz), "output_bytes": int(out_bytes),
-                    "peak_bytes": int(peak)})
-        n, m, E, B = n2, m2, E2, B2
-    return out

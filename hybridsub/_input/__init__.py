@@ -5,9 +5,9 @@ from the modules inside."""
 
 from .arrays import (SCHEMES, UV_MODES, as_corner_mask, as_data, as_face_mask, as_faces, as_sharp_edges,
                      as_uv_values, as_vertices, check_options, count_of)
-from .features import Features, detect_features
+from .features import Features, detect_features, merge_detected, merge_edges
 from .gate import RefineInput, UVInput, open_gate
 
 __all__ = ["Features", "RefineInput", "SCHEMES", "UVInput", "UV_MODES", "as_corner_mask", "as_data",
            "as_face_mask", "as_faces", "as_sharp_edges", "as_uv_values", "as_vertices", "check_options", "count_of",
-           "detect_features", "open_gate"]
+           "detect_features", "merge_detected", "merge_edges", "open_gate"]

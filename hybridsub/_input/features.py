@@ -1,4 +1,8 @@
-"""Sharp-feature detection from geometry: creases by dihedral angle, corners."""
+"""Sharp-feature detection from geometry: creases by dihedral angle, corners; and the two rules
+that merge tags from several places: :func:`merge_edges` (every source alike, the largest
+sharpness wins: the command line's file tags, tag files and detected creases) and
+:func:`merge_detected` (detected features added to a caller's tags, the caller's win:
+``feature_angle=`` of the library)."""
 
 from __future__ import annotations
 
@@ -8,6 +12,7 @@ import numpy as np
 
 from .._topology import checked_level
 from . import arrays as val
+from .._topology import edge_keys
 from .._typing import ArrayLike
 
 
@@ -138,11 +143,30 @@ def merge_detected(V, F, angle, sharp_edges=None, sharpness=None, corners=None, 
     pairs, s = val.as_sharp_edges(sharp_edges, sharpness, n)
     found = feat.sharp_edges
     if len(pairs):
-        key = np.sort(pairs, axis=1) @ np.array([n, 1], dtype=np.int64)
-        fkey = np.sort(found, axis=1) @ np.array([n, 1], dtype=np.int64)
-        found = found[~np.isin(fkey, key)]
+        found = found[~np.isin(edge_keys(found[:, 0], found[:, 1], n), edge_keys(pairs[:, 0], pairs[:, 1], n))]
     pairs = np.concatenate([pairs, found])
     s = np.concatenate([s, np.full(len(found), np.inf)])
     cmask = val.as_corner_mask(corners, n)
     cmask[feat.corners] = True
     return pairs, s, np.flatnonzero(cmask)
+
+
+def merge_edges(edges: np.ndarray, sharpness: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """One entry per undirected edge of ``edges`` (k, 2), keeping its largest ``sharpness``, in
+    the order of first appearance (either orientation counts as the same edge).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> e, s = merge_edges(np.array([[0, 1], [2, 1], [1, 0]]), np.array([2.0, np.inf, 5.0]), 3)
+    >>> e.tolist(), s.tolist()
+    ([[0, 1], [2, 1]], [5.0, inf])
+    """
+    if not len(edges):
+        return edges.reshape(0, 2).astype(np.int64), sharpness
+    key = edge_keys(edges[:, 0], edges[:, 1], n_vertices)
+    uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
+    best = np.zeros(len(uniq))
+    np.maximum.at(best, inv.ravel(), sharpness)
+    order = np.argsort(first, kind="stable")
+    return edges[first[order]].astype(np.int64), best[order]

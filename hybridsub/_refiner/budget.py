@@ -33,6 +33,9 @@ import numpy as np
 from .._rules import refinement as R
 from . import stencils as _stencils
 from .._errors import OutputTooLargeError
+from .._input import count_of
+from .._topology import edge_keys, undirected_edges
+from .._units import bytes_and_count, fmt_bytes
 from .._typing import MemoryLimit
 
 ENV_VAR = "HYBRIDSUB_MAX_MEMORY"
@@ -125,21 +128,6 @@ def _resolve(max_memory) -> tuple[float, str]:
     return DEFAULT_FRACTION * phys, f"the default (80 % of this machine's {fmt_bytes(phys)} of RAM)"
 
 
-def _both(x: float) -> str:
-    """'8.0 GB (8,000,000,000 bytes)', or just '512 bytes'."""
-    short = fmt_bytes(x)
-    return short if short.endswith("bytes") or not math.isfinite(x) else f"{short} ({x:,.0f} bytes)"
-
-
-def fmt_bytes(x: float) -> str:
-    if not math.isfinite(x):
-        return "unlimited"
-    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if x >= size:
-            return f"{x / size:.1f} {unit}"
-    return f"{int(x)} bytes"
-
-
 # --------------------------------------------------------------------------------------
 # Counting
 
@@ -160,6 +148,12 @@ class Counts:
     @property
     def edges(self) -> float:
         return (3 * self.m + self.boundary) / 2
+
+
+def step_nnz(n, edges, edge_points, face_points):
+    """Entries of one step's matrix: a row of ``1 + valence`` per old vertex (``n + 2 edges``
+    in all), four per edge point (a trisected edge has two), three per face point."""
+    return n + 2 * edges + 4 * edge_points + 3 * face_points
 
 
 @dataclass(frozen=True)
@@ -224,7 +218,7 @@ def estimate(first: Counts, scheme: str, step: int, levels: int, keeps_steps: bo
     big = False
     for k in range(step, levels + 1):
         e = c.edges
-        nnz = c.n + 2 * e + 4 * c.split + 8 * c.trisect + 3 * c.face_points
+        nnz = step_nnz(c.n, e, c.split + 2 * c.trisect, c.face_points)
         nxt = _next(c, scheme, k)
         nnz_total += nnz
         big = big or max(nnz, nxt.n, c.n) >= _stencils.INT32_LIMIT
@@ -276,11 +270,10 @@ class Budget:
         todo = self.levels - step + 1
         suggestion = _suggest(est.bytes)
         return (
-            f"{start} {level.n_faces:,} faces by {todo} {'more ' if step > 1 else ''}"
-            f"level{'s' if todo != 1 else ''} "
+            f"{start} {level.n_faces:,} faces by {count_of(todo, 'more level' if step > 1 else 'level')} "
             f"(scheme {self.scheme!r}) would make about {est.faces:,} faces and {est.vertices:,} vertices "
-            f"and need about {_both(est.bytes)} of memory (estimated before allocating), "
-            f"more than the limit of {_both(self.limit)} set by "
+            f"and need about {bytes_and_count(est.bytes)} of memory (estimated before allocating), "
+            f"more than the limit of {bytes_and_count(self.limit)} set by "
             f"{self.source}. Ask for fewer levels, or raise the limit: max_memory={suggestion!r} in this "
             f"call, hybridsub.set_memory_limit({suggestion!r}) for the process, or the environment "
             f"variable {ENV_VAR}={suggestion}; 'none' turns the check off"
@@ -314,8 +307,132 @@ def check_product(A, B, max_memory=None, what="the composite refinement matrix")
         s = _suggest(need)
         raise OutputTooLargeError(
             f"forming {what} ({A.shape[0]:,} × {B.shape[1]:,}, up to {nnz:,.0f} entries) would need about "
-            f"{_both(need)} of memory, more than the limit of {_both(limit)} set by {source}. "
+            f"{bytes_and_count(need)} of memory, more than the limit of {bytes_and_count(limit)} set by {source}. "
             "Refine data with Refinement.apply (step by step, no "
             f"composite), or raise the limit: hybridsub.set_memory_limit({s!r}) or the environment "
             f"variable {ENV_VAR}={s}; 'none' turns the check off"
         )
+
+
+# --------------------------------------------------------------------------------------
+# Exact counts per level (what ``hybridsub info`` and the command line's memory check read)
+
+#: Bytes per face of one step's topology tables and classification (halfedge twins, edge
+#: numbering, vertex→edge incidence, step plan). Measured as the peak RSS of
+#: ``refine(F, levels=1)`` + ``apply`` minus everything else ``predict_levels`` counts:
+#: 175–210 bytes per face on armadillo (L1, L2 inputs; hybrid, loop, sqrt3) and fandisk L3.
+TOPOLOGY_BYTES_PER_FACE = 200
+
+
+def _split_halfedges(F, pairs, eid, cnt, n_vertices, sharp_edges, sharpness, sharp_faces):
+    """(sharp face mask, sharpness of each split halfedge of a smooth face) at level 0 of ``"hybrid"``."""
+    m0, E = len(F), len(pairs)
+    sharp = np.zeros(m0, bool)
+    if sharp_faces is not None:
+        sf = np.asarray(sharp_faces)
+        if sf.dtype == bool:
+            sharp |= sf
+        else:
+            sharp[sf.astype(np.int64)] = True
+    es = np.zeros(E)
+    if sharp_edges is not None and len(sharp_edges):
+        se = np.asarray(sharp_edges, dtype=np.int64).reshape(-1, 2)
+        s = (np.full(len(se), np.inf) if sharpness is None
+             else R.normalize_sharpness(np.asarray(sharpness, dtype=np.float64)))
+        key = edge_keys(se[:, 0], se[:, 1], n_vertices)
+        ekey = edge_keys(pairs[:, 0], pairs[:, 1], n_vertices)
+        pos = np.searchsorted(ekey, key)
+        ok = (pos < E) & (ekey[np.minimum(pos, E - 1)] == key)
+        np.maximum.at(es, pos[ok], s[ok])
+    es[cnt == 1] = np.inf
+    # for each halfedge, is the other face on its edge sharp?
+    order = np.argsort(eid, kind="stable")
+    other_sharp = np.zeros(3 * m0, bool)
+    two = cnt[eid[order]] == 2
+    h1, h2 = order[two][0::2], order[two][1::2]
+    other_sharp[h1] = sharp[h2 // 3]
+    other_sharp[h2] = sharp[h1 // 3]
+    hs = np.where(other_sharp, np.inf, es[eid])
+    return sharp, hs[~np.repeat(sharp, 3) & (hs > 0)]
+
+
+def predict_levels(F: np.ndarray, n_vertices: int, levels: int, *, scheme: str = "hybrid", sharp_edges=None,
+                   sharpness=None, sharp_faces=None, attributes: int = 3) -> list[dict]:
+    """Exact counts of every level of ``subdivide``, and a memory estimate, from level 0 alone.
+
+    Counting rules (exact for any valid input; ``tests/test_cli.py`` checks them against ``refine``):
+    every edge lies in one or two faces, so ``E = (3F + B) / 2`` at every level (B: boundary
+    edges), and the Euler characteristic ``V − E + F`` never changes; hence ``V`` follows from
+    ``F`` and ``B``. ``"loop"``: ``F ← 4F``, ``B ← 2B``. ``"sqrt3"``: ``F ← 3F``; ``B`` is
+    unchanged in odd steps and trisected (``B ← 3B``) in even ones. ``"hybrid"``: a sharp face
+    makes 4 sharp faces, a smooth face ``3 + s`` smooth faces (``s`` split edges). A split
+    halfedge of a smooth face has two split children in two smooth faces while its edge stays
+    split: for ever on a boundary or next to a sharp face, ``⌈σ⌉`` levels for a crease of
+    sharpness ``σ`` between smooth faces. So with ``Fs, Fh`` smooth and sharp faces and ``σ_h``
+    the sharpness of each split halfedge of a smooth face at level 0,
+    ``H_k = Σ_h 2^k [σ_h > k]``, ``Fs ← 3Fs + H_k``, ``Fh ← 4Fh``, ``B ← 2B``.
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+        A valid mesh's faces (every edge in one or two faces).
+    n_vertices, levels, scheme, sharp_edges, sharpness, sharp_faces
+        As for ``refine``; ``sharp_faces`` as a boolean mask or indices.
+    attributes : int
+        Floats per vertex being refined (3 for positions, more with colours or UVs).
+
+    Returns
+    -------
+    list of dict, one per level 1..levels
+        ``faces``, ``vertices``, ``edges``, ``boundary_edges``, ``nnz`` (an upper bound of the
+        step matrix's non-zeros), ``output_bytes`` (positions and faces, float64/int64) and
+        ``peak_bytes`` (estimated peak working memory of that step, as ``hybridsub subdivide``
+        runs it: the previous level, the step's tables and matrix, and the new level).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])   # a tetrahedron
+    >>> [(p["faces"], p["vertices"]) for p in predict_levels(F, 4, 2, scheme="loop")]
+    [(16, 10), (64, 34)]
+    """
+    F = np.asarray(F, dtype=np.int64)
+    m0 = len(F)
+    pairs, eid, cnt = undirected_edges(F, n_vertices)
+    E = len(pairs)
+    B = int((cnt == 1).sum())
+    Fh = Fs = 0
+    H = np.empty(0)
+    if scheme == "loop":
+        Fh = m0
+    elif scheme == "hybrid":
+        sharp, H = _split_halfedges(F, pairs, eid, cnt, n_vertices, sharp_edges, sharpness, sharp_faces)
+        Fh, Fs = int(sharp.sum()), int((~sharp).sum())
+    out = []
+    n, m = n_vertices, m0
+    for k in range(levels):
+        step = k + 1
+        if scheme == "loop":
+            m2, B2, face_points = 4 * m, 2 * B, 0
+        elif scheme == "sqrt3":
+            odd = step % 2 == 1
+            m2, B2 = 3 * m, (B if odd else 3 * B)
+            face_points = m if odd else m - B
+        else:
+            Hk = int(np.sum(np.where(H > k, 2.0 ** k, 0.0)))
+            Fs2, Fh2 = 3 * Fs + Hk, 4 * Fh
+            m2, B2, face_points = Fs2 + Fh2, 2 * B, Fs
+            Fs, Fh = Fs2, Fh2
+        E2 = (3 * m2 + B2) // 2
+        n2 = n + (E2 - E) - (m2 - m)
+        nnz = step_nnz(n, E, n2 - n - face_points, face_points)
+        out_bytes = 8 * attributes * n2 + 24 * m2
+        peak = (8 * attributes * n + 24 * m  # the level being refined
+                + TOPOLOGY_BYTES_PER_FACE * m  # its tables and the step plan
+                + 12 * nnz + 8 * (n2 + 1)  # the step matrix (CSR)
+                + out_bytes + 8 * m2)  # the new level and its face parents
+        out.append({"level": step, "faces": int(m2), "vertices": int(n2), "edges": int(E2),
+                    "boundary_edges": int(B2), "nnz": int(nnz), "output_bytes": int(out_bytes),
+                    "peak_bytes": int(peak)})
+        n, m, E, B = n2, m2, E2, B2
+    return out
