@@ -11,12 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import render as _render
+from .pipeline import SCHEME_NAMES
 from .._input import count_of
 from .._refiner import refine
 from .._topology import undirected_edges
-
-SCHEME_TITLES = {"sqrt3": "Kobbelt √3", "hybrid": "hybrid √3–Loop", "loop": "Loop"}
-
 
 @dataclass
 class Panel:
@@ -45,7 +43,7 @@ def compare_panels(V, F, levels: int, *, sharp_edges=None, sharpness=None, sharp
         tags = {} if scheme == "sqrt3" else dict(sharpness=sharpness, sharp_faces=sharp_faces, corners=corners)
         r = refine(F, None if scheme == "sqrt3" else sharp_edges, levels, n_vertices=len(V), scheme=scheme,
                    loop_weights=loop_weights, **tags)
-        panels.append(Panel(f"{SCHEME_TITLES[scheme]}, {count_of(levels, 'level')}",
+        panels.append(Panel(f"{SCHEME_NAMES[scheme]}, {count_of(levels, 'level')}",
                             r.apply(V), r.faces, f"{len(r.faces):,} faces"))
     return panels
 

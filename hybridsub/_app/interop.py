@@ -9,7 +9,7 @@ import numpy as np
 from .. import _input as val
 from .._io import classes
 from .._errors import MeshError
-from .._input import detect_features
+from .._input import detect_features, merge_edges
 from .._refiner import Refinement, refine
 from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
@@ -138,30 +138,7 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
             'a triangle spanning two UV charts); use scheme="hybrid" or "loop", or weld=False to refine the mesh '
             "as stored (its seams open, as boundaries)")
 
-    # tags, in the welded vertex numbers
-    edges_w: np.ndarray | None = None
-    sharp_w: np.ndarray | None = None
-    corners_w: np.ndarray | None = None
-    if sharp_edges is not None:
-        pairs, sharp_w = val.as_sharp_edges(sharp_edges, sharpness, n)
-        edges_w = w.geo[pairs]
-        same = edges_w[:, 0] == edges_w[:, 1]
-        if same.any():
-            i = int(np.flatnonzero(same)[0])
-            raise MeshError(f"sharp edge {i} = {pairs[i].tolist()} joins two vertices at the same position, which "
-                            "welding merges; pass weld=False, or drop that edge")
-    elif sharpness is not None and np.size(sharpness):
-        raise ValueError("sharpness was given without sharp_edges")
-    if corners is not None:
-        corners_w = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
-    if feature_angle is not None:
-        feat = detect_features(w.V, w.F, feature_angle)
-        if edges_w is None or sharp_w is None:
-            edges_w, sharp_w = feat.sharp_edges, None
-        else:
-            edges_w = np.vstack([edges_w, feat.sharp_edges])
-            sharp_w = np.concatenate([sharp_w, np.full(len(feat.sharp_edges), np.inf)])
-        corners_w = feat.corners if corners_w is None else np.union1d(corners_w, feat.corners)
+    edges_w, sharp_w, corners_w = _welded_tags(w, n, sharp_edges, sharpness, corners, feature_angle)
 
     try:
         r = refine(w.F, edges_w, levels, n_vertices=len(w.V), scheme=scheme, sharpness=sharp_w,
@@ -191,6 +168,36 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     }
     return trimesh.Trimesh(out.positions(), out.faces, visual=visual, process=False, validate=False,
                            metadata=metadata, vertex_attributes=vattr, face_attributes=fattr)
+
+
+def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angle):
+    """The caller's tags in the welded vertex numbers, and the features detected on the welded
+    mesh merged in (the largest sharpness wins); None where there are none."""
+    edges_w: np.ndarray | None = None
+    sharp_w: np.ndarray | None = None
+    corners_w: np.ndarray | None = None
+    if sharp_edges is not None:
+        pairs, sharp_w = val.as_sharp_edges(sharp_edges, sharpness, n)
+        edges_w = w.geo[pairs]
+        same = edges_w[:, 0] == edges_w[:, 1]
+        if same.any():
+            i = int(np.flatnonzero(same)[0])
+            raise MeshError(f"sharp edge {i} = {pairs[i].tolist()} joins two vertices at the same position, which "
+                            "welding merges; pass weld=False, or drop that edge")
+    elif sharpness is not None and np.size(sharpness):
+        raise ValueError("sharpness was given without sharp_edges")
+    if corners is not None:
+        corners_w = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
+    if feature_angle is not None:
+        feat = detect_features(w.V, w.F, feature_angle)
+        if edges_w is None:
+            edges_w, sharp_w = feat.sharp_edges, None
+        else:
+            edges_w, sharp_w = merge_edges(np.vstack([edges_w, feat.sharp_edges]),
+                                           np.concatenate([sharp_w, np.full(len(feat.sharp_edges), np.inf)]),
+                                           len(w.V))
+        corners_w = feat.corners if corners_w is None else np.union1d(corners_w, feat.corners)
+    return edges_w, sharp_w, corners_w
 
 
 # ---------------------------------------------------------------------------------------

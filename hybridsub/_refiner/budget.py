@@ -18,6 +18,11 @@ crease still a crease). It adds what the finished :class:`~hybridsub.Refinement`
 face parents, tags and the matrix of every step), the largest temporary tables of one step, and
 two position arrays of the finest level. It errs on the high side; it is a guard against
 asking for levels that cannot fit, not an exact account.
+
+:func:`predict_levels` is the exact account, from level 0 alone: the faces, vertices and
+edges of every level and the peak memory of the level-by-level run of the command line
+(``hybridsub info`` prints it; the command refuses runs above 80 % of the RAM with it). Both
+count a step's matrix entries with :func:`step_nnz`.
 """
 
 from __future__ import annotations
