@@ -316,8 +316,8 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
           scheme: Scheme = "hybrid", feature_angle: float | None = None, feature_sharpness: float | None = None,
           format: str = "obj", loop_weights: LoopWeights = "loop", ignore_tags: bool = False,
           triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, force: bool = False,
-          scheduler=None, workers: int | None = None, verify: bool = False, progress: bool = False, on_result: Callable[[dict], None] | None = None,
-          ) -> BatchSummary:
+          scheduler=None, workers: int | None = None, verify: bool = False, progress: bool = False,
+          on_result: Callable[[dict], None] | None = None) -> BatchSummary:
     """Subdivide many mesh files on Dask, one task per mesh, resuming where an earlier call stopped.
 
     Each worker reads its input and writes its output itself (nothing large goes through the

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import logging
 import os
 import sys
 import time
@@ -23,6 +24,7 @@ from .._input import SCHEMES, count_of, detect_features
 from .._io import example_path
 from .._units import short_bytes
 from .._version import __version__
+from .batch import batch
 from .pipeline import (SCHEME_NAMES, FileOptions, PipelineError, check_memory, gather_features, keeps_uv, load_mesh,
                        predict_file_levels, refine_mesh, say, seams, subdivide_file)
 from .report import mesh_report
@@ -46,16 +48,13 @@ def cmd_subdivide(a) -> int:
 
 
 def cmd_batch(a) -> int:
-    import logging
-
-    from .batch import batch
-
     # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
     try:
         s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
                   feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format,
-                  loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate, weld=a.weld, force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
+                  loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate, weld=a.weld,
+                  force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
                   progress=not a.quiet and sys.stderr.isatty())
     except RuntimeError as e:
         raise PipelineError(str(e)) from None
@@ -298,8 +297,10 @@ def _tag_options(p, *, scheme=True, input_opts=True, tag_files=True) -> None:
     if tag_files:
         g.add_argument("--sharp-edges", metavar="FILE", dest="sharp_edges_file",
                        help="crease edges: 'i j' or 'i j sharpness' per line, 0-based")
-        g.add_argument("--sharp-faces", metavar="FILE", dest="sharp_faces_file", help="faces split by Loop's rule: face indices, 0-based")
-        g.add_argument("--corners", metavar="FILE", dest="corners_file", help="corner vertices: vertex indices, 0-based")
+        g.add_argument("--sharp-faces", metavar="FILE", dest="sharp_faces_file",
+                       help="faces split by Loop's rule: face indices, 0-based")
+        g.add_argument("--corners", metavar="FILE", dest="corners_file",
+                       help="corner vertices: vertex indices, 0-based")
     g.add_argument("--ignore-tags", action="store_true", help="ignore crease/corner tags stored in the input file")
     if input_opts:
         g = p.add_argument_group("input")
