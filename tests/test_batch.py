@@ -4,7 +4,6 @@ the manifest is complete, and a killed worker, a killed run or a changed option 
 is unfinished or changed."""
 
 import hashlib
-import importlib
 import io
 import json
 import os
@@ -21,13 +20,11 @@ from distributed import KilledWorker
 
 import hybridsub
 from conftest import DATA
+from hybridsub._app import batch as _batch
 from hybridsub._app.manifest import MANIFEST, TMPDIR, Manifest, assign_outputs, expand_inputs
 from hybridsub._app.cli import main
 from hybridsub._app.progress import BatchProgress
 from strategies import grid, sphere_hull, torus
-
-# the module: hybridsub._app.batch as an attribute is the function batch, which hybridsub._app exports
-_batch = importlib.import_module("hybridsub._app.batch")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OPTS = ["--levels", "2", "--feature-angle", "30"]
