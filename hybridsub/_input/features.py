@@ -130,25 +130,30 @@ def detect_features(V: ArrayLike, F: ArrayLike, angle: float = 30.0, *,
     return Features(ev[sharp], ev[~interior], np.flatnonzero(corner))
 
 
-def merge_detected(V, F, angle, sharp_edges=None, sharpness=None, corners=None, *, corner_angle=45.0):
-    """Add the features detected at ``angle`` to the caller's tags (theirs take precedence).
+def merge_detected(feat: Features, pairs: np.ndarray, sharpness: np.ndarray, corner: np.ndarray,
+                   n_vertices: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Add detected features to checked tags (the caller's take precedence).
 
-    Detected sharp edges that the caller already tagged keep the caller's sharpness; the
-    others are infinitely sharp. Corners are the union. Returns ``(sharp_edges, sharpness,
-    corners)`` for :func:`hybridsub.refine` (corners as indices).
+    Detected sharp edges that the caller already tagged (``pairs`` (k, 2) with ``sharpness``)
+    keep the caller's sharpness; the others are infinitely sharp. Corners are the union (a new
+    (n,) mask). Returns ``(pairs, sharpness, corner)``.
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V, F = hybridsub.load_example()
+    >>> feat = detect_features(V, F, 30)
+    >>> pairs, s, corner = merge_detected(feat, feat.sharp_edges[:1], np.array([2.0]), np.zeros(len(V), bool), len(V))
+    >>> len(pairs), s[:2].tolist(), int(corner.sum())
+    (722, [2.0, inf], 23)
     """
-    Vf = val.as_vertices(V)
-    feat = detect_features(Vf, F, angle, corner_angle=corner_angle)
-    n = len(Vf)
-    pairs, s = val.as_sharp_edges(sharp_edges, sharpness, n)
     found = feat.sharp_edges
     if len(pairs):
-        found = found[~np.isin(edge_keys(found[:, 0], found[:, 1], n), edge_keys(pairs[:, 0], pairs[:, 1], n))]
-    pairs = np.concatenate([pairs, found])
-    s = np.concatenate([s, np.full(len(found), np.inf)])
-    cmask = val.as_corner_mask(corners, n)
-    cmask[feat.corners] = True
-    return pairs, s, np.flatnonzero(cmask)
+        found = found[~np.isin(edge_keys(found[:, 0], found[:, 1], n_vertices),
+                               edge_keys(pairs[:, 0], pairs[:, 1], n_vertices))]
+    corner = corner.copy()
+    corner[feat.corners] = True
+    return (np.concatenate([pairs, found]), np.concatenate([sharpness, np.full(len(found), np.inf)]), corner)
 
 
 def merge_edges(edges: np.ndarray, sharpness: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._topology import Cut, Level, checked_level, cut_non_manifold, duplicate_faces_error, map_sharp_edges, uv_start
 from . import arrays as val
-from .features import detect_features
+from .features import detect_features, merge_detected
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,7 +120,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
     corner = val.as_corner_mask(corners, n)
     if feature_angle is not None:
-        pairs, sharp = _merge_detected(positions, Fi, feature_angle, pairs, sharp, corner)
+        pairs, sharp, corner = merge_detected(detect_features(positions, Fi, feature_angle), pairs, sharp, corner, n)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(_SQRT3_TAGS)
     if scheme == "loop":
@@ -159,20 +159,3 @@ def _cut(Fi: np.ndarray, n: int, pairs: np.ndarray, sharp: np.ndarray) -> Cut | 
     creased = np.zeros(n, dtype=bool)
     creased[pairs[sharp > 0].ravel()] = True
     return cut_non_manifold(Fi, n, creased)
-
-
-def _merge_detected(V, Fi, angle, pairs, sharp, corner):
-    """Add the features detected at ``angle`` to checked tags (the caller's take precedence).
-
-    Detected sharp edges the caller already tagged keep the caller's sharpness; the others
-    are infinitely sharp. Detected corners are set in ``corner`` (a fresh mask, in place).
-    """
-    feat = detect_features(V, Fi, angle)
-    n = len(V)
-    found = feat.sharp_edges
-    if len(pairs):
-        key = np.sort(pairs, axis=1) @ np.array([n, 1], dtype=np.int64)
-        fkey = np.sort(found, axis=1) @ np.array([n, 1], dtype=np.int64)
-        found = found[~np.isin(fkey, key)]
-    corner[feat.corners] = True
-    return np.concatenate([pairs, found]), np.concatenate([sharp, np.full(len(found), np.inf)])
