@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from .._errors import MeshError
 from .._input import check_options, count_of
-from .._rules.refinement import normalize_sharpness
+from .._rules import normalize_sharpness
 from .._typing import LoopWeights, Scheme
 from .._units import si
 from .._version import __version__

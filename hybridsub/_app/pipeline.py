@@ -22,7 +22,7 @@ from .._errors import MeshError, OutputTooLargeError
 from .._input import count_of, detect_features, merge_edges
 from .._io import TaggedMesh
 from .._refiner import physical_memory, predict_levels, seam_edges
-from .._rules.refinement import normalize_sharpness
+from .._rules import normalize_sharpness
 from .._topology import edge_keys, undirected_edges
 from .._units import rate, short_bytes
 from .progress import ProgressBar, refine_by_level

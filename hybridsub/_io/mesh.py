@@ -11,7 +11,7 @@ import numpy as np
 
 from .._errors import MeshError
 from .._input import as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices
-from .._rules.refinement import INFINITE_SHARPNESS
+from .._rules import INFINITE_SHARPNESS
 
 #: Sharpness written for infinitely sharp creases and corners (OpenSubdiv's convention:
 #: a sharpness of 10 or more is infinitely sharp).
