@@ -43,7 +43,7 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     >>> import numpy as np
     >>> s = setup_limit(np.array([[0, 1, 2]]), None, 1, None, "sqrt3", None, None, None, "loop")
     >>> s.same_level, s.n_keep, s.level.n_vertices                 # √3 is evaluated at even levels
-    (False, 4, 6)
+    (False, 4, 10)
     """
     levels = check_options(scheme, levels, loop_weights)
     Fi, n = as_faces(F, n_vertices)

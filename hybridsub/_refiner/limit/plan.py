@@ -101,7 +101,7 @@ def plan_level(level: Level, esharp: np.ndarray, face_sharp: np.ndarray, corner:
     >>> level = build_level(np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]), 4)
     >>> esharp = np.zeros(level.n_edges)
     >>> plan = plan_level(level, esharp, np.ones(4, bool), np.zeros(4, bool), "loop", "loop")
-    >>> plan.pos_ok.all(), plan.limit_csr(4).toarray()[0].round(4).tolist()
+    >>> bool(plan.pos_ok.all()), plan.limit_csr(4).toarray()[0].round(4).tolist()
     (True, [0.4, 0.2, 0.2, 0.2])
     """
     sec = vertex_sectors(level, esharp > 0)
@@ -193,8 +193,9 @@ def _ring_masks(coo: _Coo, sec: Sectors, ss_all: np.ndarray, row_of, ring_len, m
 def _limit_rows(level: Level, sec: Sectors, vc: _Vertices, esharp, scheme, loop_weights) -> tuple:
     """COO (row, col, weight) of the limit masks of the vertices that have one."""
     coo = _Coo(2, 1)
-    ev = level.edge_vertices.ravel()
-    other = level.edge_vertices[:, ::-1].ravel()  # the far end of each edge end
+    ends = level.edge_vertices
+    ev = ends.ravel()
+    other = ends[:, ::-1].ravel()  # the far end of each edge end
     # Corners: the vertex itself.
     v = np.flatnonzero(vc.corner)
     coo.add(v, v, np.ones(len(v)))
