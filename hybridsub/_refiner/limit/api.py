@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import as_faces, as_vertices, check_options
+from ..._input import (as_corner_mask, as_faces, as_sharp_edges, as_vertices, check_options, detect_features,
+                       merge_detected)
 from ..._topology import Level, build_level
 from ..._typing import ArrayLike, LoopWeights, Scheme
 from ..refinement import refine
@@ -83,11 +84,14 @@ def _check_tol(tol, max_levels):
 
 
 def _features(V, F, feature_angle, sharp_edges, sharpness, corners):
+    """The caller's tags with the features detected at ``feature_angle`` added (theirs win)."""
     if feature_angle is None:
         return sharp_edges, sharpness, corners
-    from ..._input.features import merge_detected
-
-    return merge_detected(V, F, feature_angle, sharp_edges, sharpness, corners)
+    n = len(V)
+    pairs, sharp = as_sharp_edges(sharp_edges, sharpness, n)
+    pairs, sharp, corner = merge_detected(detect_features(V, F, feature_angle), pairs, sharp,
+                                          as_corner_mask(corners, n), n)
+    return pairs, sharp, np.flatnonzero(corner)
 
 
 # ---------------------------------------------------------------------------------------------
