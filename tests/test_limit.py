@@ -292,9 +292,10 @@ def test_loop_crease_sector_normals_converge():
     V, F = load_mesh("mesh_with_border")
     Nc = hybridsub.limit_normals(V, F, scheme="loop", per_face_corner=True)
     n = len(V)
-    from hybridsub._refiner.limit import _setup, _plan
-    s = _setup(F, None, 0, n, "loop", None, None, None, "loop")
-    pl = _plan(s.level, s.esharp, s.face_sharp, s.corner, "loop", "loop")
+    from hybridsub._refiner.limit.api import setup_limit
+    from hybridsub._refiner.limit.plan import plan_level
+    s = setup_limit(F, None, 0, n, "loop", None, None, None, "loop")
+    pl = plan_level(s.level, s.esharp, s.face_sharp, s.corner, "loop", "loop")
     k = pl.sectors.n_faces
     sec_n = np.zeros((len(k), 3))
     sec_n[pl.sectors.he_sector] = Nc.reshape(-1, 3)
@@ -412,7 +413,7 @@ def test_bad_input():
 def test_dart_mixed_and_fin_normals():
     # Darts and mixed vertices of the hybrid scheme: the control fan's normal after FAN_LEVELS
     # local levels (no tangent plane there); stable, unit, on the side the faces face.
-    from hybridsub._refiner.limit import FAN_LEVELS
+    from hybridsub._refiner.limit.local import FAN_LEVELS
     V, F = _sphere(1)
     e = np.array([F[0, :2]])
     for kw in ({"sharp_edges": e}, {"sharp_faces": np.arange(0, len(F), 3)}):

@@ -9,6 +9,7 @@ from .emit import child_creases, child_level, face_parents
 from .errors import duplicate_faces_error, not_an_edge_error, topology_error
 from .level import Level, build_level, checked_level
 from .plan import StepPlan, plan_step, step_arguments
+from .sectors import Sectors, vertex_sectors
 from .uv import linear_rows, seam_halfedges, uv_start
 
 __all__ = ["Cut", "EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_level", "checked_level",
@@ -16,3 +17,4 @@ __all__ = ["Cut", "EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_l
            "group_halfedges", "halfedge_ends", "linear_rows", "map_sharp_edges", "next_halfedge",
            "not_an_edge_error", "plan_step", "prev_halfedge", "seam_halfedges", "step_arguments", "topology_error",
            "undirected_edges", "uv_start"]
+__all__ += ["Sectors", "vertex_sectors"]

@@ -1,0 +1,315 @@
+"""The public limit functions: :func:`limit_matrix`, :func:`limit_positions`,
+:func:`limit_normals`, and the one evaluation of a level they share (plan, then local
+refinement where needed)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..._input import (as_corner_mask, as_faces, as_sharp_edges, as_vertices, check_options, detect_features,
+                       merge_detected)
+from ..._topology import Level, build_level
+from ..._typing import ArrayLike, LoopWeights, Scheme
+from ..refinement import refine
+from .local import refine_locally
+from .normals import sector_normals, unit
+from .plan import SEC_TRANSIENT, edge_sharpness, plan_level
+
+# ---------------------------------------------------------------------------------------------
+# Input preparation: the mesh refined to the level evaluated, its tags per edge, face, vertex
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class LimitSetup:
+    """A mesh and its tags, refined to the level the limit is evaluated at."""
+
+    level: Level | None  # the level evaluated (None: no faces)
+    tagged: np.ndarray
+    esharp: np.ndarray
+    face_sharp: np.ndarray
+    corner: np.ndarray
+    refinement: object  # the Refinement to the evaluated level
+    n_keep: int  # vertices of the requested level
+    same_level: bool  # evaluated at the requested level (else one finer: Kobbelt's parity)
+
+
+def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners,
+                loop_weights) -> LimitSetup:
+    """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
+
+    >>> import numpy as np
+    >>> s = setup_limit(np.array([[0, 1, 2]]), None, 1, None, "sqrt3", None, None, None, "loop")
+    >>> s.same_level, s.n_keep, s.level.n_vertices                 # √3 is evaluated at even levels
+    (False, 4, 10)
+    """
+    levels = check_options(scheme, levels, loop_weights)
+    Fi, n = as_faces(F, n_vertices)
+    # Kobbelt's boundary rule alternates: evaluate where the next step is odd.
+    l_eval = levels + (1 if scheme == "sqrt3" and levels % 2 else 0)
+    r = refine(Fi, sharp_edges, l_eval, n_vertices=n, scheme=scheme, sharpness=sharpness,
+               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+    n_keep = r.steps[levels - 1].n_vertices if levels else n
+    faces = r.faces
+    n_eval = r.n_vertices
+    m = len(faces)
+    fsh = np.asarray(r.sharp_faces)
+    face_sharp = np.zeros(m, dtype=bool)
+    if fsh.dtype == bool:
+        face_sharp[:] = fsh
+    else:
+        face_sharp[fsh] = True
+    if scheme == "loop":
+        face_sharp[:] = True
+    corner = np.zeros(n_eval, dtype=bool)
+    corner[np.asarray(r.corners, dtype=np.int64)] = True
+    if m == 0:
+        return LimitSetup(None, None, None, face_sharp, corner, r, n_keep, l_eval == levels)
+    level = build_level(faces, n_eval)
+    tagged, esharp = edge_sharpness(level, np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
+                                    np.asarray(r.sharpness, np.float64), scheme)
+    return LimitSetup(level, tagged, esharp, face_sharp, corner, r, n_keep, l_eval == levels)
+
+
+def _check_tol(tol, max_levels):
+    tol = float(tol)
+    if not tol > 0:
+        raise ValueError(f"tol must be positive, got {tol}")
+    if isinstance(max_levels, bool) or int(max_levels) != max_levels or max_levels < 1:
+        raise ValueError(f"max_levels must be a positive integer, got {max_levels!r}")
+    return tol, int(max_levels)
+
+
+def _features(V, F, feature_angle, sharp_edges, sharpness, corners):
+    """The caller's tags with the features detected at ``feature_angle`` added (theirs win)."""
+    if feature_angle is None:
+        return sharp_edges, sharpness, corners
+    n = len(V)
+    pairs, sharp = as_sharp_edges(sharp_edges, sharpness, n)
+    pairs, sharp, corner = merge_detected(detect_features(V, F, feature_angle), pairs, sharp,
+                                          as_corner_mask(corners, n), n)
+    return pairs, sharp, np.flatnonzero(corner)
+
+
+# ---------------------------------------------------------------------------------------------
+# The evaluation of one level
+# ---------------------------------------------------------------------------------------------
+
+
+def _evaluate(s: LimitSetup, scheme, loop_weights, X, want_rows, tol, max_levels):
+    """Limit matrix (n × n CSR, or None), plan and sector normals (or None) of the level evaluated."""
+    level = s.level
+    n = level.n_vertices
+    plan = plan_level(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
+    nrm = sector_normals(level, plan, X) if X is not None else None
+    need = np.zeros(n, dtype=bool)
+    if want_rows:
+        need |= ~plan.pos_ok
+    if X is not None:
+        need[plan.sectors.vertex[plan.sec_kind == SEC_TRANSIENT]] = True
+    centers = np.flatnonzero(need)
+    rows = None
+    if len(centers):
+        rows, est = refine_locally(level, s.tagged, s.face_sharp, s.corner, scheme, loop_weights, centers, plan, X,
+                                   want_rows, tol, max_levels)
+        if X is not None:
+            t = plan.sec_kind == SEC_TRANSIENT
+            nrm[t] = est[t]
+    if not want_rows:
+        return None, plan, nrm
+    L = plan.limit_csr(n)
+    if rows is not None:
+        moved = sp.csr_matrix((np.ones(len(centers)), (centers, np.arange(len(centers)))), shape=(n, len(centers)))
+        L = L + moved @ rows
+    L = sp.csr_matrix(L)
+    L.sum_duplicates()
+    L.sort_indices()
+    return L, plan, nrm
+
+
+def _vertex_normals(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Unit normal of every vertex: the normalized sum of its sectors' unit normals."""
+    N = np.zeros((level.n_vertices, 3))
+    np.add.at(N, plan.sectors.vertex, nrm)
+    # Sectors facing opposite ways (a fin: a crease that turns back on itself) cancel; there
+    # the vertex gets its control fan's normal instead.
+    cancel = np.linalg.norm(N, axis=1) < 1e-6
+    if cancel.any():
+        Fl = level.faces
+        fn = np.cross(X[Fl[:, 1]] - X[Fl[:, 0]], X[Fl[:, 2]] - X[Fl[:, 0]])
+        fan = np.zeros_like(N)
+        for i in range(3):
+            np.add.at(fan, Fl[:, i], fn)
+        N[cancel] = fan[cancel]
+    return unit(N)
+
+
+# ---------------------------------------------------------------------------------------------
+# Public API
+# ---------------------------------------------------------------------------------------------
+
+
+def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                 n_vertices: int | None = None, scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                 sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                 loop_weights: LoopWeights = "loop", tol: float = 1e-12, max_levels: int = 60) -> sp.csr_matrix:
+    """The limit matrix: where every vertex of a level goes when refined forever.
+
+    Parameters
+    ----------
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    sharp_edges : (k, 2) array_like of int, optional
+        Crease edges (vertex pairs, either orientation), as for :func:`hybridsub.refine`.
+    levels : int
+        Give the limit positions of the vertices of this level of refinement (0: the input).
+    n_vertices : int, optional
+        Number of vertices; default ``F.max() + 1``.
+    scheme : {"hybrid", "sqrt3", "loop"}
+        The subdivision scheme whose limit is meant.
+    sharpness, sharp_faces, corners, loop_weights
+        As for :func:`hybridsub.refine`.
+    tol : float
+        Vertices without a stationary limit mask (``docs/limit.md``) are refined locally until
+        their weights change by less than this.
+    max_levels : int
+        At most this many local refinements (a ``RuntimeWarning`` says if ``tol`` was missed).
+
+    Returns
+    -------
+    L : scipy.sparse.csr_matrix, (n_L, n)
+        Limit positions of the level-``levels`` vertices are ``L @ V``. Rows are affine
+        (sum to 1) and non-negative (up to rounding where a row was extrapolated).
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])   # tetrahedron
+    >>> L = hybridsub.limit_matrix(F, scheme="loop")
+    >>> L.shape, np.allclose(L.sum(axis=1), 1)
+    ((4, 4), True)
+    >>> L[0].toarray().round(4)                     # Loop's limit mask at valence 3
+    array([[0.4, 0.2, 0.2, 0.2]])
+    """
+    tol, max_levels = _check_tol(tol, max_levels)
+    s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+    r = s.refinement
+    if s.level is None:
+        L = sp.identity(r.n_vertices, format="csr")
+    else:
+        L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
+    out = sp.csr_matrix((L @ r.matrix)[: s.n_keep])
+    out.sort_indices()
+    return out
+
+
+def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                    scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                    sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                    loop_weights: LoopWeights = "loop", feature_angle: float | None = None, tol: float = 1e-12,
+                    max_levels: int = 60) -> np.ndarray:
+    """Limit positions of a mesh's vertices: the points of the limit surface they converge to.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, tol, max_levels
+        As for :func:`limit_matrix`.
+    feature_angle : float, optional
+        Also tag the features :func:`hybridsub.detect_features` finds at this angle (degrees),
+        as :func:`hybridsub.subdivide` does.
+
+    Returns
+    -------
+    (n_L, 3) ndarray
+        Limit positions of the vertices of level ``levels`` (in the dtype of ``V`` if it is
+        floating-point).
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    >>> P = hybridsub.limit_positions(V, F, scheme="sqrt3")     # Kobbelt: β_3 = 5/8
+    >>> P[0] * 6
+    array([1., 1., 1.])
+    """
+    A = np.asarray(V)
+    Vf = as_vertices(A)
+    tol, max_levels = _check_tol(tol, max_levels)
+    sharp_edges, sharpness, corners = _features(Vf, F, feature_angle, sharp_edges, sharpness, corners)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
+    X = s.refinement.apply(Vf)
+    if s.level is not None:
+        L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
+        X = L @ X
+    out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
+    return np.ascontiguousarray(X[: s.n_keep], dtype=out_dtype)
+
+
+def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                  scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                  sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                  loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
+                  per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60) -> np.ndarray:
+    """Unit normals of the limit surface at the limit positions of a mesh's vertices.
+
+    Smooth vertices get the normal of the limit surface's tangent plane (Kobbelt's and
+    Loop's tangent masks). On a crease each side (sector) has its own normal; a vertex gets
+    the normalized mean of its sectors' unit normals, ``per_face_corner=True`` gives each
+    face corner the normal of its sector (split normals, for shading). ``docs/limit.md``
+    says what each kind of vertex gets, and where the limit surface has no tangent plane.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, feature_angle
+        As for :func:`limit_positions`.
+    per_face_corner : bool
+        Return one normal per face corner, ``(m_L, 3, 3)``, instead of one per vertex.
+    tol, max_levels
+        For the vertices without stationary tangent masks, refined locally until the normal
+        changes by less than ``tol`` (or ``max_levels`` levels).
+
+    Returns
+    -------
+    (n_L, 3) ndarray, or (m_L, 3, 3) with ``per_face_corner``
+        Unit normals on the side the faces face (right-hand rule on ``F``'s order); zero at
+        vertices no face uses.
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    >>> N = hybridsub.limit_normals(V, F, scheme="loop")
+    >>> np.allclose(N, V / np.sqrt(3))                 # outward, by symmetry
+    True
+    """
+    A = np.asarray(V)
+    Vf = as_vertices(A)
+    tol, max_levels = _check_tol(tol, max_levels)
+    sharp_edges, sharpness, corners = _features(Vf, F, feature_angle, sharp_edges, sharpness, corners)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
+    r = s.refinement
+    F_out = r.steps[levels - 1].faces if levels else r.faces
+    if s.level is None:
+        N = np.zeros((s.n_keep, 3))
+        return np.zeros((len(F_out), 3, 3)) if per_face_corner else N
+    X = r.apply(Vf)
+    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    N = _vertex_normals(s.level, plan, nrm, X)
+    if per_face_corner:
+        if s.same_level:
+            return nrm[plan.sectors.he_sector].reshape(-1, 3, 3)
+        return N[F_out]
+    return N[: s.n_keep]
