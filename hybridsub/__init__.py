@@ -28,4 +28,4 @@ __all__ = [
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
     "batch", "BatchSummary",
 ]
-from ._version import __version__  # noqa: E402
+from ._version import __version__ as __version__

@@ -12,9 +12,8 @@ from .plan import StepPlan, plan_step, step_arguments
 from .sectors import Sectors, vertex_sectors
 from .uv import linear_rows, seam_halfedges, uv_start
 
-__all__ = ["Cut", "EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_level", "checked_level",
+__all__ = ["Cut", "EdgeGroups", "Level", "Sectors", "StepPlan", "UndirectedEdges", "build_level", "checked_level",
            "child_creases", "child_level", "cut_non_manifold", "duplicate_faces_error", "edge_keys", "face_parents",
            "group_halfedges", "halfedge_ends", "linear_rows", "map_sharp_edges", "next_halfedge",
            "not_an_edge_error", "plan_step", "prev_halfedge", "seam_halfedges", "step_arguments", "topology_error",
-           "undirected_edges", "uv_start"]
-__all__ += ["Sectors", "vertex_sectors"]
+           "undirected_edges", "uv_start", "vertex_sectors"]

@@ -4,16 +4,16 @@ refinement where needed)."""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import (as_corner_mask, as_faces, as_sharp_edges, as_vertices, check_options, detect_features,
-                       merge_detected)
+from ..._input import as_vertices, open_gate
 from ..._topology import Level, build_level
 from ..._typing import ArrayLike, LoopWeights, Scheme
-from ..refinement import refine
+from ..refinement import refinement_of
 from .local import refine_locally
 from .normals import sector_normals, unit
 from .plan import SEC_TRANSIENT, edge_sharpness, plan_level
@@ -37,8 +37,8 @@ class LimitSetup:
     same_level: bool  # evaluated at the requested level (else one finer: Kobbelt's parity)
 
 
-def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners,
-                loop_weights) -> LimitSetup:
+def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+                positions=None, feature_angle=None) -> LimitSetup:
     """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
 
     >>> import numpy as np
@@ -46,12 +46,13 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     >>> s.same_level, s.n_keep, s.level.n_vertices                 # √3 is evaluated at even levels
     (False, 4, 10)
     """
-    levels = check_options(scheme, levels, loop_weights)
-    Fi, n = as_faces(F, n_vertices)
+    inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, positions=positions,
+                    feature_angle=feature_angle)
+    levels, n = inp.levels, inp.n_vertices
     # Kobbelt's boundary rule alternates: evaluate where the next step is odd.
     l_eval = levels + (1 if scheme == "sqrt3" and levels % 2 else 0)
-    r = refine(Fi, sharp_edges, l_eval, n_vertices=n, scheme=scheme, sharpness=sharpness,
-               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+    r = refinement_of(dataclasses.replace(inp, levels=l_eval))
     n_keep = r.steps[levels - 1].n_vertices if levels else n
     faces = r.faces
     n_eval = r.n_vertices
@@ -81,17 +82,6 @@ def _check_tol(tol, max_levels):
     if isinstance(max_levels, bool) or int(max_levels) != max_levels or max_levels < 1:
         raise ValueError(f"max_levels must be a positive integer, got {max_levels!r}")
     return tol, int(max_levels)
-
-
-def _features(V, F, feature_angle, sharp_edges, sharpness, corners):
-    """The caller's tags with the features detected at ``feature_angle`` added (theirs win)."""
-    if feature_angle is None:
-        return sharp_edges, sharpness, corners
-    n = len(V)
-    pairs, sharp = as_sharp_edges(sharp_edges, sharpness, n)
-    pairs, sharp, corner = merge_detected(detect_features(V, F, feature_angle), pairs, sharp,
-                                          as_corner_mask(corners, n), n)
-    return pairs, sharp, np.flatnonzero(corner)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -243,8 +233,8 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     A = np.asarray(V)
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
-    sharp_edges, sharpness, corners = _features(Vf, F, feature_angle, sharp_edges, sharpness, corners)
-    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
+                    positions=Vf, feature_angle=feature_angle)
     X = s.refinement.apply(Vf)
     if s.level is not None:
         L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
@@ -298,8 +288,8 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     A = np.asarray(V)
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
-    sharp_edges, sharpness, corners = _features(Vf, F, feature_angle, sharp_edges, sharpness, corners)
-    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
+                    positions=Vf, feature_angle=feature_angle)
     r = s.refinement
     F_out = r.steps[levels - 1].faces if levels else r.faces
     if s.level is None:

@@ -14,10 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._errors import MeshError
 from ..._rules import limit as LR
 from ..._rules import refinement as R
-from ..._topology import Level, Sectors, vertex_sectors
+from ..._topology import Level, Sectors, not_an_edge_error, vertex_sectors
 
 # How a sector's normal is found.
 SEC_SMOOTH = 0  # cos/sin tangent masks (Kobbelt and Loop smooth vertices)
@@ -62,8 +61,7 @@ def edge_sharpness(level: Level, pairs: np.ndarray, sharpness: np.ndarray, schem
     if len(pairs):
         eid = level.find_edges(pairs)
         if (eid < 0).any():
-            j = int(np.flatnonzero(eid < 0)[0])
-            raise MeshError(f"sharp edge {j} = {pairs[j].tolist()} is not an edge of the mesh")
+            raise not_an_edge_error(pairs, np.flatnonzero(eid < 0))
         np.maximum.at(tagged, eid, sharpness)
     boundary = level.boundary_edge
     if scheme == "sqrt3":
