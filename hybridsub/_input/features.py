@@ -10,7 +10,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._topology import checked_level
+from .._topology import Level, checked_level
 from . import arrays as val
 from .._topology import edge_keys
 from .._typing import ArrayLike
@@ -37,7 +37,8 @@ class Features(NamedTuple):
     corners: np.ndarray
 
 
-def _check_angle(name, a):
+def check_angle(name: str, a) -> float:
+    """An angle option in degrees, checked: a number in [0, 180]."""
     try:
         a = float(a)
     except (TypeError, ValueError):
@@ -88,13 +89,28 @@ def detect_features(V: ArrayLike, F: ArrayLike, angle: float = 30.0, *,
     """
     Vf = val.as_vertices(V)
     Fi, n = val.as_faces(F, len(Vf))
-    angle = _check_angle("angle", angle)
+    angle = check_angle("angle", angle)
     if corner_angle is not None:
-        corner_angle = _check_angle("corner_angle", corner_angle)
+        corner_angle = check_angle("corner_angle", corner_angle)
     if len(Fi) == 0:
         empty = np.empty((0, 2), np.int64)
         return Features(empty, empty.copy(), np.empty(0, np.int64))
-    level = checked_level(Fi, n)
+    return features_of_level(Vf, checked_level(Fi, n), angle, corner_angle)
+
+
+def features_of_level(V: np.ndarray, level: Level, angle: float, corner_angle: float | None = 45.0) -> Features:
+    """:func:`detect_features` on checked input: ``V`` (n, 3) float64 and the mesh's level
+    (its faces, twins and edge numbering), angles in degrees already checked.
+
+    Examples
+    --------
+    >>> import hybridsub
+    >>> from hybridsub._topology import checked_level
+    >>> V, F = hybridsub.load_example()
+    >>> len(features_of_level(V, checked_level(F, len(V)), 30.0).sharp_edges)
+    722
+    """
+    Vf, Fi, n = V, level.faces, level.n_vertices
     ev = level.edge_vertices
     owner = level.edge_owner
     twin = level.twin[owner]

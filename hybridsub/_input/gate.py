@@ -21,7 +21,7 @@ import numpy as np
 
 from .._topology import Cut, Level, checked_level, cut_non_manifold, duplicate_faces_error, map_sharp_edges, uv_start
 from . import arrays as val
-from .features import detect_features, merge_detected
+from .features import check_angle, detect_features, features_of_level, merge_detected
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,8 +119,12 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
     face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
     corner = val.as_corner_mask(corners, n)
-    if feature_angle is not None:
-        pairs, sharp, corner = merge_detected(detect_features(positions, Fi, feature_angle), pairs, sharp, corner, n)
+    level = None
+    if feature_angle is not None:  # on the input's level, which then serves the refinement too
+        angle = check_angle("feature_angle", feature_angle)
+        level = checked_level(Fi, n, pairs)
+        feat = features_of_level(positions, level, angle) if len(Fi) else detect_features(positions, Fi, angle)
+        pairs, sharp, corner = merge_detected(feat, pairs, sharp, corner, n)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(_SQRT3_TAGS)
     if scheme == "loop":
@@ -130,7 +134,8 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     cut = _cut(Fi, n, pairs, sharp) if cut_asked else None
     if cut is None:
         keep = sharp > 0
-        level = checked_level(Fi, n, pairs).tag(pairs[keep], sharp[keep], face_sharp)
+        level = (level if level is not None else checked_level(Fi, n, pairs)).tag(pairs[keep], sharp[keep],
+                                                                                   face_sharp)
         return RefineInput(Fi, n, sharp_edges=pairs[keep], sharpness=sharp[keep], corner=corner, level=level,
                            uv=_with_uv_level(uv, level, corner), **common)
     cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)
