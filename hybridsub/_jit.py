@@ -25,7 +25,8 @@ import sys
 import types
 
 from numba import njit
-from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
+from numba.core.dispatcher import Dispatcher
 
 # ``from X import a, b`` (parenthesised over lines or not) and ``import X``, at a line's start.
 _FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
@@ -47,12 +48,13 @@ def kernel(fn=None, **options):
     """
     if fn is None:
         return functools.partial(kernel, **options)
-    dispatcher = njit(cache=True, **options)(fn)
-    if not isinstance(getattr(dispatcher, "_cache", None), FunctionCache):  # Numba's internals moved
+    dispatcher = njit(**options)(fn)
+    if not isinstance(dispatcher, Dispatcher):  # NUMBA_DISABLE_JIT: the plain function
+        return dispatcher
+    if not isinstance(getattr(dispatcher, "_cache", None), NullCache):  # Numba's internals moved
         raise RuntimeError("numba's dispatcher keeps its cache elsewhere: update hybridsub._jit")
-    dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)
+    dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # what Dispatcher.enable_caching does
     return dispatcher
-
 
 def threaded_and_serial(fn):
     """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
