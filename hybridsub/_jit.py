@@ -56,6 +56,7 @@ def kernel(fn=None, **options):
     dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # what Dispatcher.enable_caching does
     return dispatcher
 
+
 def threaded_and_serial(fn):
     """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
     as ``range``). The serial twin is a copy of the function under its own name, so the two
@@ -72,7 +73,9 @@ def dependencies(module: str) -> tuple[str, ...]:
     ``module`` itself and every module of its package it imports from, transitively.
 
     A name imported from a package (``from .._topology import dest``) counts as its defining
-    module where it has one (functions, kernels), else as the package's ``__init__``.
+    module where it has one (functions, kernels), else as the package's ``__init__``. Imports
+    are read from the source (``from X import ...`` and ``import X`` statements at a line's
+    start), so constants count too; names reached otherwise (``importlib``) do not.
     """
     seen = {module}
     todo = [module]
@@ -115,9 +118,9 @@ def _origin(base: str, name: str) -> str:
     if f"{base}.{name}" in sys.modules:
         return f"{base}.{name}"
     obj = getattr(sys.modules.get(base), name, None)
-    where = getattr(getattr(obj, "py_func", obj), "__module__", None)
-    if isinstance(where, str) and where.split(".", 1)[0] == base.split(".", 1)[0] and not isinstance(
-            obj, types.ModuleType):
+    where = getattr(getattr(obj, "py_func", obj), "__module__", None)  # constants have none
+    top = base.split(".", 1)[0]
+    if isinstance(where, str) and (where == top or where.startswith(top + ".")):
         return where
     return base
 

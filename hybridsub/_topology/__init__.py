@@ -4,6 +4,7 @@ tags, never positions. Other layers import from here, never from the modules ins
 
 from ._halfedge_kernels import dest, edge_sharpness, next_in_face, opposite, origin, prev_in_face
 from ._kernels import use_threads
+from ._sector_kernels import vertex_sectors
 from .cut import Cut, cut_non_manifold, map_sharp_edges
 from .edges import (EdgeGroups, UndirectedEdges, edge_keys, group_halfedges, halfedge_ends, next_halfedge,
                     prev_halfedge, undirected_edges)
@@ -18,4 +19,4 @@ __all__ = ["Cut", "EdgeGroups", "Level", "StepPlan", "UndirectedEdges", "build_l
            "edge_sharpness", "face_parents", "group_halfedges", "halfedge_ends", "linear_rows", "map_sharp_edges",
            "next_halfedge", "next_in_face", "not_an_edge_error", "opposite", "origin", "plan_step", "prev_halfedge",
            "prev_in_face", "seam_halfedges", "step_arguments", "topology_error", "undirected_edges", "use_threads",
-           "uv_start"]
+           "uv_start", "vertex_sectors"]
