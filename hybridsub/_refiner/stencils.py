@@ -13,8 +13,8 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from .._topology import _kernels as K
-from .._topology import Level, StepPlan, step_arguments
+from .._topology import Level, StepPlan, step_arguments, use_threads
+from . import _stencil_kernels as K
 
 #: Largest index a CSR matrix stores as int32 (above it, int64 indices).
 INT32_LIMIT = np.iinfo(np.int32).max
@@ -41,7 +41,7 @@ def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:
     """``S @ X`` for (n, k) float64 data, without forming S."""
     X = np.ascontiguousarray(X, dtype=np.float64)
     out = np.empty((plan.n_new, X.shape[1]), np.float64)
-    if level.n_faces >= K.PARALLEL_MIN:
+    if use_threads(level.n_faces):
         K.apply_step(X, *step_arguments(level, plan), out, numba.get_num_threads())
     else:
         K.apply_step_serial(X, *step_arguments(level, plan), out, 1)
@@ -52,6 +52,6 @@ def apply_matrix(S: sp.csr_matrix, X: np.ndarray) -> np.ndarray:
     """``S @ X`` for (n, k) float64 data, rows in parallel; the same bits as SciPy's product."""
     X = np.ascontiguousarray(X, dtype=np.float64)
     out = np.empty((S.shape[0], X.shape[1]), np.float64)
-    kernel = K.csr_apply if S.shape[0] >= K.PARALLEL_MIN else K.csr_apply_serial
+    kernel = K.csr_apply if use_threads(S.shape[0]) else K.csr_apply_serial
     kernel(S.indptr, S.indices, S.data, X, out)
     return out

@@ -1,100 +1,66 @@
-"""Numba kernels: the per-element loops of topology, classification, stencils and emission.
+"""Numba kernels of the topology layer: twins, edge numbering, classification, vertex
+coefficients and the emission of the next level.
 
 Private. Every kernel takes contiguous arrays (int64 indices, float64 data, int8 codes,
 bool masks) and plain scalars; no Python objects. Large outputs are allocated by the
-callers in ``_topology`` and ``_stencils`` (NumPy backs big arrays with huge pages, which
-makes first touch several times cheaper than Numba's own allocations) and filled here.
-
-Halfedge ``h = 3 f + i`` of face ``f`` runs ``F[f, i] → F[f, (i+1) % 3]``; ``twin[h]`` is the
-halfedge across (−1 on the boundary). An edge is *owned* by its lower-numbered halfedge, and
-edges are numbered in owner order: the order of first appearance over the halfedges.
+callers in ``level`` (NumPy backs big arrays with huge pages, which makes first touch
+several times cheaper than Numba's own allocations) and filled here. Halfedges are implicit
+(see ``_halfedge_kernels``). An edge is *owned* by its lower-numbered halfedge, and edges are
+numbered in owner order: the order of first appearance over the halfedges.
 
 One step runs ``classify_step`` (edge kinds, new-point layout, vertex statistics), then
-``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``), then either
-``apply_step`` (positions directly) or ``matrix_row_sizes`` and ``fill_matrix`` (the CSR
-matrix S) — all walk the same rows in the same order, so ``apply_step(X) == S @ X`` bit for
-bit — and ``emit_faces`` with ``emit_topology`` (the next level's faces, then its twins and
-tags, derived from this level's instead of searched again).
+``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``); the refiner's
+stencil kernels turn these into rows of S; ``emit_faces`` with ``emit_topology`` make the next
+level's faces, then its twins and tags, derived from this level's instead of searched again.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import types
+from numba import prange
 
-from numba import njit, prange
-
+from .._jit import kernel, threaded_and_serial
 from .._rules.refinement import (
     CORNER,
     EDGE_FLIP,
     EDGE_KEEP,
     EDGE_SPLIT,
     EDGE_TRISECT,
-    KOBBELT_TRISECTION,
     REGION_LOOP,
     REGION_MIXED,
     REGION_SQRT3,
     SCHEME_SQRT3,
     SMOOTH,
-    edge_weights,
     vertex_mask,
     vertex_rule,
 )
+from ._halfedge_kernels import dest, edge_sharpness, next_in_face, origin, prev_in_face
 
 # Error codes of halfedge_twins.
 OK = 0
 ERR_SAME_DIRECTION = 1  # two halfedges u→w: non-manifold edge or inconsistent orientation
 ERR_MULTIPLE_TWINS = 2  # several halfedges w→u for one u→w
 
-_T0, _T1, _T2 = KOBBELT_TRISECTION
-_THIRD = 1.0 / 3.0
-
 #: Inputs smaller than this (faces or rows) run the serial twin of a threaded kernel:
 #: starting threads costs more than the work.
 PARALLEL_MIN = 20000
 
 
-def _threaded_and_serial(fn):
-    """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
-    as ``range``). The serial twin is a copy of the function under its own name, so the
-    two have separate on-disk caches."""
-    serial = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__,
-                                fn.__closure__)
-    serial.__qualname__ = fn.__qualname__ + "_serial"
-    serial.__doc__ = fn.__doc__
-    return njit(cache=True, parallel=True)(fn), njit(cache=True)(serial)
+def use_threads(rows: int) -> bool:
+    """Whether a kernel over ``rows`` faces or rows runs its threaded twin (``PARALLEL_MIN``
+    read at call time).
 
-
-@njit(cache=True, inline="always")
-def _dest(F, h):
-    return F[h // 3, (h % 3 + 1) % 3]
-
-
-@njit(cache=True, inline="always")
-def _origin(F, h):
-    return F[h // 3, h % 3]
-
-
-@njit(cache=True, inline="always")
-def _opposite(F, h):
-    return F[h // 3, (h % 3 + 2) % 3]
-
-
-@njit(cache=True, inline="always")
-def _next(h):
-    return h - h % 3 + (h % 3 + 1) % 3
-
-
-@njit(cache=True, inline="always")
-def _prev(h):
-    return h - h % 3 + (h % 3 + 2) % 3
+    >>> use_threads(10), use_threads(10 ** 6)
+    (False, True)
+    """
+    return rows >= PARALLEL_MIN
 
 
 # ---------------------------------------------------------------------------------------
 # Topology of an input mesh (level 0). Later levels get their twins from emit_topology.
 
 
-@njit(cache=True)
+@kernel
 def group_by_origin(F, n_vertices):
     """Halfedges grouped by origin vertex (a counting sort): ``by_origin[start[v]:start[v+1]]``
     are the halfedges leaving v, in increasing order. Returns (by_origin, start)."""
@@ -115,7 +81,7 @@ def group_by_origin(F, n_vertices):
     return by_origin, start
 
 
-@njit(cache=True)
+@kernel
 def halfedge_twins(F, n_vertices):
     """Twin of every halfedge (−1 on the boundary), and halfedges grouped by origin.
 
@@ -125,21 +91,21 @@ def halfedge_twins(F, n_vertices):
     """
     nh = 3 * F.shape[0]
     by_origin, start = group_by_origin(F, n_vertices)
-    dest = np.empty(nh, np.int64)  # destination of by_origin[k], so every group scans contiguously
+    ends = np.empty(nh, np.int64)  # destination of by_origin[k], so every group scans contiguously
     for k in range(nh):
-        dest[k] = _dest(F, by_origin[k])
+        ends[k] = dest(F, by_origin[k])
     twin = np.full(nh, -1, np.int64)
     for u in range(n_vertices):
         for k in range(start[u], start[u + 1]):
-            w = dest[k]
+            w = ends[k]
             h = by_origin[k]
             for q in range(k + 1, start[u + 1]):
-                if dest[q] == w:
+                if ends[q] == w:
                     return twin, by_origin, start, ERR_SAME_DIRECTION, h
             if twin[h] >= 0:
                 continue
             for q in range(start[w], start[w + 1]):
-                if dest[q] == u:
+                if ends[q] == u:
                     g = by_origin[q]
                     if twin[h] >= 0:
                         return twin, by_origin, start, ERR_MULTIPLE_TWINS, h
@@ -148,7 +114,7 @@ def halfedge_twins(F, n_vertices):
     return twin, by_origin, start, OK, -1
 
 
-@njit(cache=True)
+@kernel
 def find_halfedges(pairs, F, by_origin, origin_start):
     """A halfedge of each vertex pair's edge (either orientation), −1 where there is none."""
     k = pairs.shape[0]
@@ -161,20 +127,20 @@ def find_halfedges(pairs, F, by_origin, origin_start):
             continue
         for q in range(origin_start[a], origin_start[a + 1]):
             h = by_origin[q]
-            if _dest(F, h) == b:
+            if dest(F, h) == b:
                 out[j] = h
                 break
         if out[j] >= 0:
             continue
         for q in range(origin_start[b], origin_start[b + 1]):
             h = by_origin[q]
-            if _dest(F, h) == a:
+            if dest(F, h) == a:
                 out[j] = h
                 break
     return out
 
 
-@njit(cache=True)
+@kernel
 def number_edges(twin):
     """Edge of each halfedge and owner halfedge of each edge, edges in owner order."""
     nh = twin.shape[0]
@@ -192,7 +158,7 @@ def number_edges(twin):
     return edge_of, owner[:ne].copy()
 
 
-@njit(cache=True)
+@kernel
 def boundary_links(F, twin):
     """For each boundary halfedge, the next and previous boundary halfedges (−1 elsewhere).
 
@@ -205,12 +171,12 @@ def boundary_links(F, twin):
     for h in range(nh):
         if twin[h] >= 0:
             continue
-        g = _next(h)
+        g = next_in_face(h)
         for _ in range(nh):
             t = twin[g]
             if t < 0:
                 break
-            g = _next(t)
+            g = next_in_face(t)
         bnext[h] = g
         bprev[g] = h
     return bnext, bprev
@@ -220,17 +186,7 @@ def boundary_links(F, twin):
 # Classification of one step.
 
 
-@njit(cache=True, inline="always")
-def _sharpness(h, twin, hsharp, has_tags):
-    """Sharpness of h's edge this step: inf on the boundary, the tag inside (0 untagged)."""
-    if twin[h] < 0:
-        return np.inf
-    if has_tags:
-        return hsharp[h]
-    return 0.0
-
-
-@njit(cache=True)
+@kernel
 def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, scheme, odd, hkind, edge_point,
                   face_point, trisected, counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
@@ -254,7 +210,7 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, sch
             hkind[h] = hkind[t]
             edge_point[h] = edge_point[t]
             continue
-        s = _sharpness(h, twin, hsharp, has_tags)
+        s = edge_sharpness(h, twin, hsharp, has_tags)
         if sqrt3:
             if t < 0:
                 k = EDGE_KEEP if odd else EDGE_TRISECT
@@ -274,8 +230,8 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, sch
             nxt += 2
         else:
             edge_point[h] = -1
-        u = _origin(F, h)
-        w = _dest(F, h)
+        u = origin(F, h)
+        w = dest(F, h)
         counts[0, u] += 1
         counts[0, w] += 1
         if s > 0.0:
@@ -314,7 +270,7 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, sch
     return nxt
 
 
-@njit(cache=True)
+@kernel
 def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
                         coefficients):
     """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
@@ -346,211 +302,6 @@ def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs,
 
 
 # ---------------------------------------------------------------------------------------
-# Stencils. Rows: each old vertex (itself, then its neighbours in edge order), then the
-# edge points in edge order, then the face points. apply_step and build_matrix walk them
-# identically.
-
-
-@njit(cache=True, inline="always")
-def _neighbour_coefficient(v, s, coef):
-    c = coef[1, v]
-    if s > 0.0:
-        c += coef[2, v]
-        if s > 1.0:
-            c += coef[3, v]
-    return c
-
-
-def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks):
-    """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
-
-    Old vertices gather from their neighbours in edge order. ``chunks`` threads each take
-    one range of vertices and walk all edges, keeping their own vertices' terms, so every
-    vertex is summed in the same order whatever the number of threads. Edge and face
-    points, one row each, are computed in parallel.
-    """
-    n = coef.shape[1]
-    k = X.shape[1]
-    m = F.shape[0]
-    for c in prange(chunks):
-        lo = c * n // chunks
-        hi = (c + 1) * n // chunks
-        for v in range(lo, hi):
-            for j in range(k):
-                out[v, j] = coef[0, v] * X[v, j]
-        for h in range(3 * m):
-            t = twin[h]
-            if t >= 0 and t < h:
-                continue
-            u = _origin(F, h)
-            w = _dest(F, h)
-            mine_u = lo <= u < hi
-            mine_w = lo <= w < hi
-            if not (mine_u or mine_w):
-                continue
-            s = _sharpness(h, twin, hsharp, has_tags)
-            if mine_u:
-                cu = _neighbour_coefficient(u, s, coef)
-                if cu != 0.0:
-                    for j in range(k):
-                        out[u, j] += cu * X[w, j]
-            if mine_w:
-                cw = _neighbour_coefficient(w, s, coef)
-                if cw != 0.0:
-                    for j in range(k):
-                        out[w, j] += cw * X[u, j]
-    for h in prange(3 * m):
-        r = edge_point[h]
-        t = twin[h]
-        if r < 0 or (t >= 0 and t < h):
-            continue
-        u = _origin(F, h)
-        w = _dest(F, h)
-        if hkind[h] == EDGE_TRISECT:
-            p0 = _origin(F, bprev[h])
-            p3 = _dest(F, bnext[h])
-            for j in range(k):
-                out[r, j] = _T0 * X[p0, j] + _T1 * X[u, j] + _T2 * X[w, j]
-                out[r + 1, j] = _T2 * X[u, j] + _T1 * X[w, j] + _T0 * X[p3, j]
-            continue
-        wab, wcd = edge_weights(_sharpness(h, twin, hsharp, has_tags))
-        if wcd == 0.0:
-            for j in range(k):
-                out[r, j] = wab * X[u, j] + wab * X[w, j]
-        else:
-            a = _opposite(F, h)
-            b = _opposite(F, t)
-            for j in range(k):
-                out[r, j] = wab * X[u, j] + wab * X[w, j] + wcd * X[a, j] + wcd * X[b, j]
-    for f in prange(m):
-        r = face_point[f]
-        if r >= 0:
-            a = F[f, 0]
-            b = F[f, 1]
-            c3 = F[f, 2]
-            for j in range(k):
-                out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
-
-
-apply_step, apply_step_serial = _threaded_and_serial(_apply_step)
-
-
-@njit(cache=True)
-def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
-    """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
-    n = coef.shape[1]
-    m = F.shape[0]
-    n_new = indptr.shape[0] - 1
-    for v in range(n):
-        indptr[v + 1] = 1
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = _origin(F, h)
-        w = _dest(F, h)
-        s = _sharpness(h, twin, hsharp, has_tags)
-        if _neighbour_coefficient(u, s, coef) != 0.0:
-            indptr[u + 1] += 1
-        if _neighbour_coefficient(w, s, coef) != 0.0:
-            indptr[w + 1] += 1
-        r = edge_point[h]
-        if r < 0:
-            continue
-        if hkind[h] == EDGE_TRISECT:
-            indptr[r + 1] = 3
-            indptr[r + 2] = 3
-        else:
-            indptr[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
-    for f in range(m):
-        if face_point[f] >= 0:
-            indptr[face_point[f] + 1] = 3
-    for r in range(n_new):
-        indptr[r + 1] += indptr[r]
-
-
-@njit(cache=True)
-def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr,
-                indices, data):
-    """Fill the CSR ``indices`` and ``data`` of the step's matrix, rows in apply_step's order."""
-    n = coef.shape[1]
-    m = F.shape[0]
-    fill = indptr[:n].copy()
-    for v in range(n):
-        indices[fill[v]] = v
-        data[fill[v]] = coef[0, v]
-        fill[v] += 1
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = _origin(F, h)
-        w = _dest(F, h)
-        s = _sharpness(h, twin, hsharp, has_tags)
-        c = _neighbour_coefficient(u, s, coef)
-        if c != 0.0:
-            indices[fill[u]] = w
-            data[fill[u]] = c
-            fill[u] += 1
-        c = _neighbour_coefficient(w, s, coef)
-        if c != 0.0:
-            indices[fill[w]] = u
-            data[fill[w]] = c
-            fill[w] += 1
-        r = edge_point[h]
-        if r < 0:
-            continue
-        q = indptr[r]
-        if hkind[h] == EDGE_TRISECT:
-            indices[q] = _origin(F, bprev[h])
-            indices[q + 1] = u
-            indices[q + 2] = w
-            indices[q + 3] = u
-            indices[q + 4] = w
-            indices[q + 5] = _dest(F, bnext[h])
-            data[q] = _T0
-            data[q + 1] = _T1
-            data[q + 2] = _T2
-            data[q + 3] = _T2
-            data[q + 4] = _T1
-            data[q + 5] = _T0
-            continue
-        wab, wcd = edge_weights(s)
-        indices[q] = u
-        indices[q + 1] = w
-        data[q] = wab
-        data[q + 1] = wab
-        if wcd != 0.0:
-            indices[q + 2] = _opposite(F, h)
-            indices[q + 3] = _opposite(F, t)
-            data[q + 2] = wcd
-            data[q + 3] = wcd
-    for f in range(m):
-        r = face_point[f]
-        if r >= 0:
-            q = indptr[r]
-            for i in range(3):
-                indices[q + i] = F[f, i]
-                data[q + i] = _THIRD
-
-
-def _csr_apply(indptr, indices, data, X, out):
-    """``out = S @ X`` for CSR S, rows in parallel, each summed in stored order (as SciPy)."""
-    k = X.shape[1]
-    for r in prange(indptr.shape[0] - 1):
-        for j in range(k):
-            out[r, j] = 0.0
-        for q in range(indptr[r], indptr[r + 1]):
-            c = indices[q]
-            w = data[q]
-            for j in range(k):
-                out[r, j] += w * X[c, j]
-
-
-csr_apply, csr_apply_serial = _threaded_and_serial(_csr_apply)
-
-
-# ---------------------------------------------------------------------------------------
 # The next level: faces in parent order, and their twins and tags derived from this level.
 #
 # A smooth face emits, per halfedge u→w, a split pair A = (c, u, m), B = (c, m, w), a flip
@@ -562,7 +313,7 @@ csr_apply, csr_apply_serial = _threaded_and_serial(_csr_apply)
 #   OUT(h) = c_f→u and IN(h) = w→c_f (the spokes to f's face point).
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _first_half(h, face_sharp, first):
     i = h % 3
     if face_sharp[h // 3]:
@@ -570,7 +321,7 @@ def _first_half(h, face_sharp, first):
     return 3 * first[h] + 1
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _second_half(h, face_sharp, first):
     i = h % 3
     if face_sharp[h // 3]:
@@ -578,14 +329,14 @@ def _second_half(h, face_sharp, first):
     return 3 * (first[h] + 1) + 1
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _spoke_out(h, hkind, first):
     if hkind[h] == EDGE_FLIP:
         return 3 * first[h] + 2
     return 3 * first[h]
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _spoke_in(h, twin, hkind, first):
     k = hkind[h]
     if k == EDGE_FLIP:
@@ -595,7 +346,7 @@ def _spoke_in(h, twin, hkind, first):
     return 3 * first[h] + 2
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _apex(g, hg, trisected, edge_point, face_point):
     """The new vertex face g gives the flipped edge across its halfedge hg: its face point,
     or for a face trisected along its halfedge j, e2 across the next halfedge, e1 across
@@ -609,19 +360,19 @@ def _apex(g, hg, trisected, edge_point, face_point):
     return edge_point[3 * g + j]
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _flip_start_twin(t, hkind, trisected, face_point, first):
     """Twin of the flip triangle's halfedge u→apex(g), g the face of t (t = w→u)."""
     g = t // 3
     if face_point[g] >= 0:
-        return _spoke_out(_next(t), hkind, first)
+        return _spoke_out(next_in_face(t), hkind, first)
     j = trisected[g]
     if t == 3 * g + (j + 1) % 3:
         return 3 * first[3 * g + j] + 1
     return -1
 
 
-@njit(cache=True)
+@kernel
 def child_offsets(hkind, face_sharp, offsets, first):
     """Fill the first child face of every face (``offsets``, m + 1) and of every halfedge
     (``first``, 3m)."""
@@ -693,7 +444,7 @@ def _emit_faces(F, twin, hkind, edge_point, face_point, trisected, face_sharp, f
                 o += 1
 
 
-emit_faces, emit_faces_serial = _threaded_and_serial(_emit_faces)
+emit_faces, emit_faces_serial = threaded_and_serial(_emit_faces)
 
 
 def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs):
@@ -732,29 +483,29 @@ def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sh
             q = first[h]
             t = twin[h]
             if k == EDGE_SPLIT:
-                tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                tw[3 * q] = _spoke_in(prev_in_face(h), twin, hkind, first)
                 tw[3 * q + 1] = _second_half(t, face_sharp, first) if t >= 0 else -1
                 tw[3 * q + 2] = 3 * (q + 1)
                 tw[3 * (q + 1)] = 3 * q + 2
                 tw[3 * (q + 1) + 1] = _first_half(t, face_sharp, first) if t >= 0 else -1
-                tw[3 * (q + 1) + 2] = _spoke_out(_next(h), hkind, first)
+                tw[3 * (q + 1) + 2] = _spoke_out(next_in_face(h), hkind, first)
                 if has_tags and t >= 0 and hsharp[h] > 1.0:
                     s = hsharp[h] - 1.0 if hsharp[h] < np.inf else hsharp[h]
                     hs[3 * q + 1] = s
                     hs[3 * (q + 1) + 1] = s
             elif k == EDGE_KEEP:
-                tw[3 * q] = _spoke_in(_prev(h), twin, hkind, first)
+                tw[3 * q] = _spoke_in(prev_in_face(h), twin, hkind, first)
                 tw[3 * q + 1] = -1
-                tw[3 * q + 2] = _spoke_out(_next(h), hkind, first)
+                tw[3 * q + 2] = _spoke_out(next_in_face(h), hkind, first)
             elif k == EDGE_TRISECT:
                 tw[3 * q] = -1
-                tw[3 * q + 1] = 3 * first[twin[_next(h)]]
-                tw[3 * q + 2] = 3 * first[_prev(h)] + 2
+                tw[3 * q + 1] = 3 * first[twin[next_in_face(h)]]
+                tw[3 * q + 2] = 3 * first[prev_in_face(h)] + 2
             else:  # EDGE_FLIP
                 tw[3 * q] = _flip_start_twin(t, hkind, trisected, face_point, first)
                 tw[3 * q + 1] = 3 * first[t] + 1
                 if cf >= 0:
-                    tw[3 * q + 2] = _spoke_in(_prev(h), twin, hkind, first)
+                    tw[3 * q + 2] = _spoke_in(prev_in_face(h), twin, hkind, first)
                 else:  # f trisected along its halfedge j: h is its second or third halfedge
                     j = trisected[f]
                     if i == (j + 1) % 3:
@@ -763,4 +514,4 @@ def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sh
                         tw[3 * q + 2] = 3 * first[3 * f + j] + 2
 
 
-emit_topology, emit_topology_serial = _threaded_and_serial(_emit_topology)
+emit_topology, emit_topology_serial = threaded_and_serial(_emit_topology)

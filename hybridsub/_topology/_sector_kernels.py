@@ -14,12 +14,12 @@ edge (a closed fan with one crease, a dart, is one open sector whose two ends ar
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ._kernels import _dest, _origin, _prev
+from .._jit import kernel
+from ._halfedge_kernels import dest, origin, prev_in_face
 
 
-@njit(cache=True)
+@kernel
 def vertex_sectors(F, twin, by_origin, origin_start, crease_he):
     """Sectors of every vertex, in counter-clockwise order.
 
@@ -66,7 +66,7 @@ def vertex_sectors(F, twin, by_origin, origin_start, crease_he):
                     fan[k] = h
                     k += 1
                     visited[h] = True
-                    nxt = twin[_prev(h)]
+                    nxt = twin[prev_in_face(h)]
                     if nxt < 0:
                         break
                     if nxt == h0:
@@ -96,14 +96,14 @@ def vertex_sectors(F, twin, by_origin, origin_start, crease_he):
                         sec_slots[n_slot] = hh
                         he_sector[hh] = ns
                         n_slot += 1
-                        sec_ring[n_ring] = _dest(F, hh)
+                        sec_ring[n_ring] = dest(F, hh)
                         n_ring += 1
                         i += 1
                         if i >= k or (not cyclic and crease_he[fan[(start + i) % k]]):
                             break
                     if not cyclic:
                         last = fan[(start + i - 1) % k]
-                        sec_ring[n_ring] = _origin(F, _prev(last))
+                        sec_ring[n_ring] = origin(F, prev_in_face(last))
                         n_ring += 1
                     ns += 1
                     sec_slot_start[ns] = n_slot

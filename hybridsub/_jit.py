@@ -1,0 +1,180 @@
+"""Compiling the kernels: Numba's on-disk cache, keyed on every source a kernel compiles in.
+
+Numba's ``cache=True`` stamps a kernel's cache entry with its own file only. A kernel also
+compiles in what it calls from other modules (the scheme's rules, the halfedge primitives,
+constants), so with that stamp alone an edited rule would keep running its old compiled
+copy until the kernel's own file changed. :func:`kernel` is ``njit(cache=True)`` with a
+stamp that also covers the package modules the kernel's module imports from, followed
+transitively: any edit to them recompiles the kernel on its next first call, and a warm
+cache of unchanged sources loads as before.
+
+>>> import hybridsub
+>>> dependencies("hybridsub._topology._kernels")  # doctest: +NORMALIZE_WHITESPACE
+('hybridsub._jit', 'hybridsub._rules.refinement', 'hybridsub._topology._halfedge_kernels',
+ 'hybridsub._topology._kernels')
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import importlib.util
+import os
+import re
+import sys
+import types
+
+from numba import njit
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
+from numba.core.dispatcher import Dispatcher
+
+# ``from X import a, b`` (parenthesised over lines or not) and ``import X``, at a line's start.
+_FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n#]*)", re.M)
+
+
+def kernel(fn=None, **options):
+    """``numba.njit(cache=True, **options)``, its cache keyed on the sources it compiles in.
+
+    Use as ``@kernel`` or ``@kernel(inline="always")``. The cache lives where Numba puts it
+    (``NUMBA_CACHE_DIR``, else ``__pycache__``); only the stamp that decides whether an entry
+    is fresh differs (see :func:`dependencies`).
+
+    Examples
+    --------
+    >>> from hybridsub._topology._halfedge_kernels import dest
+    >>> type(dest._cache).__name__
+    'DependencyKeyedCache'
+    """
+    if fn is None:
+        return functools.partial(kernel, **options)
+    dispatcher = njit(**options)(fn)
+    if not isinstance(dispatcher, Dispatcher):  # NUMBA_DISABLE_JIT: the plain function
+        return dispatcher
+    if not isinstance(getattr(dispatcher, "_cache", None), NullCache):  # Numba's internals moved
+        raise RuntimeError("numba's dispatcher keeps its cache elsewhere: update hybridsub._jit")
+    dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # what Dispatcher.enable_caching does
+    return dispatcher
+
+
+def threaded_and_serial(fn):
+    """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
+    as ``range``). The serial twin is a copy of the function under its own name, so the two
+    have separate on-disk caches. Returns ``(threaded, serial)``."""
+    serial = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__,
+                                fn.__closure__)
+    serial.__qualname__ = fn.__qualname__ + "_serial"
+    serial.__doc__ = fn.__doc__
+    return kernel(parallel=True)(fn), kernel(serial)
+
+
+def dependencies(module: str) -> tuple[str, ...]:
+    """The package modules whose sources a kernel of ``module`` may compile in, sorted:
+    ``module`` itself and every module of its package it imports from, transitively.
+
+    A name imported from a package (``from .._topology import dest``) counts as its defining
+    module where it has one (functions, kernels), else as the package's ``__init__``. Imports
+    are read from the source (``from X import ...`` and ``import X`` statements at a line's
+    start), so constants count too; names reached otherwise (``importlib``) do not.
+    """
+    seen = {module}
+    todo = [module]
+    while todo:
+        for dep in _imports(todo.pop()):
+            if dep not in seen:
+                seen.add(dep)
+                todo.append(dep)
+    return tuple(sorted(seen))
+
+
+@functools.lru_cache(maxsize=None)
+def _imports(module: str) -> tuple[str, ...]:
+    """The modules of ``module``'s own top-level package that its source imports from."""
+    path = _source(module)
+    top = module.split(".", 1)[0]
+    package = module if os.path.basename(path) == "__init__.py" else module.rpartition(".")[0]
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    found = set()
+    for match in _FROM.finditer(text):
+        try:
+            base = importlib.util.resolve_name(match[1], package)
+        except (ImportError, ValueError):
+            continue
+        if base == top or base.startswith(top + "."):
+            names = match[2].strip("() \t\n").replace("\n", " ").split(",")
+            found.update(_origin(base, name.split()[0]) for name in names if name.split())
+    for match in _IMPORT.finditer(text):
+        for name in match[1].split(","):
+            name = name.split()[0] if name.split() else ""
+            if name == top or name.startswith(top + "."):
+                found.add(name)
+    found.discard(module)
+    return tuple(sorted(found))
+
+
+def _origin(base: str, name: str) -> str:
+    """The module that ``from base import name`` takes its code from."""
+    if f"{base}.{name}" in sys.modules:
+        return f"{base}.{name}"
+    obj = getattr(sys.modules.get(base), name, None)
+    where = getattr(getattr(obj, "py_func", obj), "__module__", None)  # constants have none
+    top = base.split(".", 1)[0]
+    if isinstance(where, str) and (where == top or where.startswith(top + ".")):
+        return where
+    return base
+
+
+def _source(module: str) -> str:
+    loaded = sys.modules.get(module)
+    path = getattr(loaded, "__file__", None)
+    if path is None:
+        path = importlib.util.find_spec(module).origin
+    return path
+
+
+@functools.lru_cache(maxsize=None)
+def _hash_file(path: str, mtime_ns: int, size: int) -> bytes:
+    # mtime and size in the key: a file edited while the process runs is hashed again.
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).digest()
+
+
+def _digest(path: str) -> bytes:
+    st = os.stat(path)
+    return _hash_file(path, st.st_mtime_ns, st.st_size)
+
+
+class _DependencyStamp(_CacheLocator):
+    """Numba's own locator for the function (cache directory, file names) with a source
+    stamp that adds the contents of the modules in :func:`dependencies`."""
+
+    def __init__(self, inner: _CacheLocator, module: str):
+        self._inner = inner
+        self._module = module
+
+    def ensure_cache_path(self):
+        self._inner.ensure_cache_path()
+
+    def get_cache_path(self):
+        return self._inner.get_cache_path()
+
+    def get_disambiguator(self):
+        return self._inner.get_disambiguator()
+
+    def get_source_stamp(self):
+        deps = tuple((name, _digest(_source(name))) for name in dependencies(self._module))
+        return self._inner.get_source_stamp(), deps
+
+
+class _DependencyKeyedImpl(CompileResultCacheImpl):
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        self._locator = _DependencyStamp(self._locator, py_func.__module__)
+
+
+class DependencyKeyedCache(FunctionCache):
+    """A Numba function cache whose entries go stale when any source in the kernel's
+    :func:`dependencies` changes, not only the kernel's own file."""
+
+    _impl_class = _DependencyKeyedImpl

@@ -1,0 +1,220 @@
+"""Numba kernels of one step's stencils: S applied to data directly, S assembled as CSR, and
+a CSR product.
+
+Private. Same conventions as the topology kernels (contiguous arrays and scalars in, outputs
+allocated by the caller, ``stencils``). Rows: each old vertex (itself, then its neighbours in
+edge order), then the edge points in edge order, then the face points. ``apply_step`` and
+``matrix_row_sizes`` / ``fill_matrix`` walk them identically, so ``apply_step(X) == S @ X``
+bit for bit. The vertex rows read the four coefficients of ``vertex_coefficients``; edge
+points take ``_rules.edge_weights``; face points are centroids.
+"""
+
+from __future__ import annotations
+
+from numba import prange
+
+from .._jit import kernel, threaded_and_serial
+from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
+from .._topology import dest, edge_sharpness, opposite, origin
+
+_T0, _T1, _T2 = KOBBELT_TRISECTION
+_THIRD = 1.0 / 3.0
+
+
+@kernel(inline="always")
+def _neighbour_coefficient(v, s, coef):
+    c = coef[1, v]
+    if s > 0.0:
+        c += coef[2, v]
+        if s > 1.0:
+            c += coef[3, v]
+    return c
+
+
+def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks):
+    """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
+
+    Old vertices gather from their neighbours in edge order. ``chunks`` threads each take
+    one range of vertices and walk all edges, keeping their own vertices' terms, so every
+    vertex is summed in the same order whatever the number of threads. Edge and face
+    points, one row each, are computed in parallel.
+    """
+    n = coef.shape[1]
+    k = X.shape[1]
+    m = F.shape[0]
+    for c in prange(chunks):
+        lo = c * n // chunks
+        hi = (c + 1) * n // chunks
+        for v in range(lo, hi):
+            for j in range(k):
+                out[v, j] = coef[0, v] * X[v, j]
+        for h in range(3 * m):
+            t = twin[h]
+            if t >= 0 and t < h:
+                continue
+            u = origin(F, h)
+            w = dest(F, h)
+            mine_u = lo <= u < hi
+            mine_w = lo <= w < hi
+            if not (mine_u or mine_w):
+                continue
+            s = edge_sharpness(h, twin, hsharp, has_tags)
+            if mine_u:
+                cu = _neighbour_coefficient(u, s, coef)
+                if cu != 0.0:
+                    for j in range(k):
+                        out[u, j] += cu * X[w, j]
+            if mine_w:
+                cw = _neighbour_coefficient(w, s, coef)
+                if cw != 0.0:
+                    for j in range(k):
+                        out[w, j] += cw * X[u, j]
+    for h in prange(3 * m):
+        r = edge_point[h]
+        t = twin[h]
+        if r < 0 or (t >= 0 and t < h):
+            continue
+        u = origin(F, h)
+        w = dest(F, h)
+        if hkind[h] == EDGE_TRISECT:
+            p0 = origin(F, bprev[h])
+            p3 = dest(F, bnext[h])
+            for j in range(k):
+                out[r, j] = _T0 * X[p0, j] + _T1 * X[u, j] + _T2 * X[w, j]
+                out[r + 1, j] = _T2 * X[u, j] + _T1 * X[w, j] + _T0 * X[p3, j]
+            continue
+        wab, wcd = edge_weights(edge_sharpness(h, twin, hsharp, has_tags))
+        if wcd == 0.0:
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j]
+        else:
+            a = opposite(F, h)
+            b = opposite(F, t)
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j] + wcd * X[a, j] + wcd * X[b, j]
+    for f in prange(m):
+        r = face_point[f]
+        if r >= 0:
+            a = F[f, 0]
+            b = F[f, 1]
+            c3 = F[f, 2]
+            for j in range(k):
+                out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
+
+
+apply_step, apply_step_serial = threaded_and_serial(_apply_step)
+
+
+@kernel
+def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
+    """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
+    n = coef.shape[1]
+    m = F.shape[0]
+    n_new = indptr.shape[0] - 1
+    for v in range(n):
+        indptr[v + 1] = 1
+    for h in range(3 * m):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = origin(F, h)
+        w = dest(F, h)
+        s = edge_sharpness(h, twin, hsharp, has_tags)
+        if _neighbour_coefficient(u, s, coef) != 0.0:
+            indptr[u + 1] += 1
+        if _neighbour_coefficient(w, s, coef) != 0.0:
+            indptr[w + 1] += 1
+        r = edge_point[h]
+        if r < 0:
+            continue
+        if hkind[h] == EDGE_TRISECT:
+            indptr[r + 1] = 3
+            indptr[r + 2] = 3
+        else:
+            indptr[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
+    for f in range(m):
+        if face_point[f] >= 0:
+            indptr[face_point[f] + 1] = 3
+    for r in range(n_new):
+        indptr[r + 1] += indptr[r]
+
+
+@kernel
+def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr,
+                indices, data):
+    """Fill the CSR ``indices`` and ``data`` of the step's matrix, rows in apply_step's order."""
+    n = coef.shape[1]
+    m = F.shape[0]
+    fill = indptr[:n].copy()
+    for v in range(n):
+        indices[fill[v]] = v
+        data[fill[v]] = coef[0, v]
+        fill[v] += 1
+    for h in range(3 * m):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = origin(F, h)
+        w = dest(F, h)
+        s = edge_sharpness(h, twin, hsharp, has_tags)
+        c = _neighbour_coefficient(u, s, coef)
+        if c != 0.0:
+            indices[fill[u]] = w
+            data[fill[u]] = c
+            fill[u] += 1
+        c = _neighbour_coefficient(w, s, coef)
+        if c != 0.0:
+            indices[fill[w]] = u
+            data[fill[w]] = c
+            fill[w] += 1
+        r = edge_point[h]
+        if r < 0:
+            continue
+        q = indptr[r]
+        if hkind[h] == EDGE_TRISECT:
+            indices[q] = origin(F, bprev[h])
+            indices[q + 1] = u
+            indices[q + 2] = w
+            indices[q + 3] = u
+            indices[q + 4] = w
+            indices[q + 5] = dest(F, bnext[h])
+            data[q] = _T0
+            data[q + 1] = _T1
+            data[q + 2] = _T2
+            data[q + 3] = _T2
+            data[q + 4] = _T1
+            data[q + 5] = _T0
+            continue
+        wab, wcd = edge_weights(s)
+        indices[q] = u
+        indices[q + 1] = w
+        data[q] = wab
+        data[q + 1] = wab
+        if wcd != 0.0:
+            indices[q + 2] = opposite(F, h)
+            indices[q + 3] = opposite(F, t)
+            data[q + 2] = wcd
+            data[q + 3] = wcd
+    for f in range(m):
+        r = face_point[f]
+        if r >= 0:
+            q = indptr[r]
+            for i in range(3):
+                indices[q + i] = F[f, i]
+                data[q + i] = _THIRD
+
+
+def _csr_apply(indptr, indices, data, X, out):
+    """``out = S @ X`` for CSR S, rows in parallel, each summed in stored order (as SciPy)."""
+    k = X.shape[1]
+    for r in prange(indptr.shape[0] - 1):
+        for j in range(k):
+            out[r, j] = 0.0
+        for q in range(indptr[r], indptr[r + 1]):
+            c = indices[q]
+            w = data[q]
+            for j in range(k):
+                out[r, j] += w * X[c, j]
+
+
+csr_apply, csr_apply_serial = threaded_and_serial(_csr_apply)

@@ -1,0 +1,56 @@
+"""Numba primitives on implicit halfedges, inlined into every kernel that walks a mesh.
+
+Private. Halfedge ``h = 3 f + i`` of face ``f`` runs ``F[f, i] → F[f, (i+1) % 3]``; ``twin[h]``
+is the halfedge across (−1 on the boundary). ``F`` is an (m, 3) int64 array.
+
+>>> import numpy as np
+>>> F = np.array([[0, 1, 2]])
+>>> int(origin(F, 1)), int(dest(F, 1)), int(opposite(F, 1)), int(next_in_face(2)), int(prev_in_face(0))
+(1, 2, 0, 0, 2)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import kernel
+
+
+@kernel(inline="always")
+def dest(F, h):
+    """The vertex halfedge h points to."""
+    return F[h // 3, (h % 3 + 1) % 3]
+
+
+@kernel(inline="always")
+def origin(F, h):
+    """The vertex halfedge h leaves."""
+    return F[h // 3, h % 3]
+
+
+@kernel(inline="always")
+def opposite(F, h):
+    """The vertex of h's face that is not on h."""
+    return F[h // 3, (h % 3 + 2) % 3]
+
+
+@kernel(inline="always")
+def next_in_face(h):
+    """The next halfedge of h's face."""
+    return h - h % 3 + (h % 3 + 1) % 3
+
+
+@kernel(inline="always")
+def prev_in_face(h):
+    """The previous halfedge of h's face."""
+    return h - h % 3 + (h % 3 + 2) % 3
+
+
+@kernel(inline="always")
+def edge_sharpness(h, twin, hsharp, has_tags):
+    """Sharpness of h's edge this step: inf on the boundary, the tag inside (0 untagged)."""
+    if twin[h] < 0:
+        return np.inf
+    if has_tags:
+        return hsharp[h]
+    return 0.0

@@ -1,0 +1,160 @@
+"""A rule change must reach the compiled kernels, even with a warm Numba cache.
+
+Numba's ``cache=True`` keys a kernel's cache entry on the kernel's own file; the rules it
+compiles in live elsewhere (``_rules``), so an edited rule used to keep running its old
+compiled copy. ``hybridsub._jit.kernel`` keys the entry on every package module the kernel
+imports from. These tests edit sources in a temporary copy and run fresh processes: the
+edited code with a warm cache must give what it gives with an empty one.
+"""
+
+import importlib
+import os
+import pkgutil
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import numba
+import pytest
+from numba.core.caching import NullCache
+
+import hybridsub
+from hybridsub._jit import DependencyKeyedCache, dependencies
+
+
+def _run(code: str, cwd, cache_dir) -> str:
+    """stdout of ``python -c code`` in ``cwd`` (imports from there first, then this hybridsub),
+    Numba caching into ``cache_dir``; no ``.pyc`` written, so an edit is never masked by one."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir), PYTHONDONTWRITEBYTECODE="1",
+               PYTHONPATH=os.pathsep.join([str(cwd), os.path.dirname(os.path.dirname(hybridsub.__file__))]))
+    r = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    return r.stdout.strip()
+
+
+def _edit(path, old: str, new: str) -> None:
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    assert text.count(old) == 1, old
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text.replace(old, new))
+
+
+def _package_modules():
+    for info in pkgutil.walk_packages(hybridsub.__path__, "hybridsub."):
+        if not info.name.endswith("__main__"):
+            yield importlib.import_module(info.name)
+
+
+def test_every_cached_kernel_is_keyed_on_the_modules_it_compiles_in():
+    """A kernel whose module imports from another package module must not be cached on its
+    own file alone (a plain ``njit(cache=True)`` there would bring stale kernels back)."""
+    checked = 0
+    for module in _package_modules():
+        own = [obj for obj in vars(module).values()
+               if isinstance(obj, numba.core.registry.CPUDispatcher) and obj.py_func.__module__ == module.__name__]
+        needs_key = len(dependencies(module.__name__)) > 1
+        for obj in own:
+            if isinstance(obj._cache, NullCache):
+                continue
+            checked += 1
+            if needs_key:
+                assert isinstance(obj._cache, DependencyKeyedCache), f"{module.__name__}.{obj.__name__}"
+    assert checked > 20
+
+
+def test_kernels_depend_on_the_rules_they_compile_in():
+    rules = "hybridsub._rules.refinement"
+    halfedges = "hybridsub._topology._halfedge_kernels"
+    assert {rules, halfedges} <= set(dependencies("hybridsub._topology._kernels"))
+    assert {rules, halfedges} <= set(dependencies("hybridsub._refiner._stencil_kernels"))
+    assert halfedges in dependencies("hybridsub._topology._sector_kernels")
+
+
+PACKAGE = {
+    "__init__.py": "",
+    "rules.py": """
+        from numba import njit
+
+        SCALE = 2.0
+
+
+        @njit(cache=True)
+        def weight():
+            return 0.375
+        """,
+    "kernels.py": """
+        from numba import njit
+
+        from hybridsub._jit import kernel
+
+        from .rules import SCALE, weight
+
+
+        @kernel
+        def keyed(x):
+            return SCALE * weight() * x
+
+
+        @njit(cache=True)
+        def plain(x):
+            return SCALE * weight() * x
+        """,
+}
+
+CALL = ("from rulepkg.kernels import keyed, plain\n"
+        "print(keyed(1.0), plain(1.0), keyed.stats.cache_hits[keyed.signatures[0]])")
+
+
+def test_an_edited_rule_recompiles_a_warm_kernel(tmp_path):
+    """A small package: ``keyed`` (``hybridsub._jit.kernel``) and ``plain`` (Numba's own cache)
+    both compile in a rule and a constant from another module. After the rule is edited,
+    ``keyed`` computes with the new rule; ``plain`` still runs its stale copy, which is what
+    this test would catch if the keying broke."""
+    src = tmp_path / "src"
+    (src / "rulepkg").mkdir(parents=True)
+    for name, text in PACKAGE.items():
+        (src / "rulepkg" / name).write_text(textwrap.dedent(text))
+    cache = tmp_path / "cache"
+    assert _run(CALL, src, cache) == "0.75 0.75 0"
+    assert _run(CALL, src, cache) == "0.75 0.75 1"  # warm: loaded, not compiled
+    _edit(src / "rulepkg" / "rules.py", "return 0.375", "return 0.5")
+    assert _run(CALL, src, cache) == "1.0 0.75 0"  # keyed recompiles; plain is stale
+    _edit(src / "rulepkg" / "rules.py", "SCALE = 2.0", "SCALE = 4.0")
+    assert _run(CALL, src, cache) == "2.0 0.75 0"
+
+OUTPUTS = """
+import hashlib, numpy as np, hybridsub
+assert hybridsub.__file__.startswith({root!r}), hybridsub.__file__
+V, F = hybridsub.load_example()
+feat = hybridsub.detect_features(V, F, angle=30)
+h = hashlib.sha256()
+for scheme in ("hybrid", "loop"):
+    V2, F2 = hybridsub.subdivide(V, F, feat.sharp_edges, levels=2, scheme=scheme, corners=feat.corners,
+                                 sharpness=np.full(len(feat.sharp_edges), 1.5))
+    S = hybridsub.refine(F, feat.sharp_edges, levels=1, n_vertices=len(V), scheme=scheme).matrix
+    for a in (V2, F2, S.data, S.indices, S.indptr):
+        h.update(np.ascontiguousarray(a).tobytes())
+print(h.hexdigest())
+"""
+
+
+@pytest.mark.slow
+def test_an_edited_rule_changes_the_package_as_an_empty_cache_does(tmp_path):
+    """The package copied, run with a cache; Loop's 3/8 edge weight and the smooth vertex mask
+    edited; run again with that warm cache and with an empty one: the same bits (and not the
+    unedited ones)."""
+    src = tmp_path / "src"
+    shutil.copytree(os.path.dirname(hybridsub.__file__), src / "hybridsub",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    code = OUTPUTS.format(root=str(src))
+    warm = tmp_path / "warm"
+    before = _run(code, src, warm)
+    rules = src / "hybridsub" / "_rules" / "refinement.py"
+    _edit(rules, "(1.0 - s) * 0.375", "(1.0 - s) * 0.4")
+    _edit(rules, "return 1.0 - n * smooth_w, smooth_w, 0.0, 0.0",
+          "return 1.0 - n * (0.5 * smooth_w), 0.5 * smooth_w, 0.0, 0.0")
+    edited_warm = _run(code, src, warm)
+    edited_cold = _run(code, src, tmp_path / "empty")
+    assert edited_warm == edited_cold != before
