@@ -37,7 +37,7 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     twin = np.empty(3 * total if want_topology else 0, np.int64)
     hsharp = np.zeros(3 * total if want_topology and has_tags else 0)
     child_sharp = np.zeros(total if want_topology else 0, bool)
-    big = m >= K.PARALLEL_MIN
+    big = K.use_threads(m)
     (K.emit_faces if big else K.emit_faces_serial)(
         level.faces, level.twin, plan.hkind, plan.edge_point, plan.face_point, plan.trisected, face_sharp, first,
         faces)
