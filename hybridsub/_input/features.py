@@ -92,9 +92,6 @@ def detect_features(V: ArrayLike, F: ArrayLike, angle: float = 30.0, *,
     angle = check_angle("angle", angle)
     if corner_angle is not None:
         corner_angle = check_angle("corner_angle", corner_angle)
-    if len(Fi) == 0:
-        empty = np.empty((0, 2), np.int64)
-        return Features(empty, empty.copy(), np.empty(0, np.int64))
     return features_of_level(Vf, checked_level(Fi, n), angle, corner_angle)
 
 
@@ -110,6 +107,9 @@ def features_of_level(V: np.ndarray, level: Level, angle: float, corner_angle: f
     >>> len(features_of_level(V, checked_level(F, len(V)), 30.0).sharp_edges)
     722
     """
+    if level.n_faces == 0:
+        empty = np.empty((0, 2), np.int64)
+        return Features(empty, empty.copy(), np.empty(0, np.int64))
     Vf, Fi, n = V, level.faces, level.n_vertices
     ev = level.edge_vertices
     owner = level.edge_owner

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._topology import Cut, Level, checked_level, cut_non_manifold, duplicate_faces_error, map_sharp_edges, uv_start
 from . import arrays as val
-from .features import check_angle, detect_features, features_of_level, merge_detected
+from .features import check_angle, features_of_level, merge_detected
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,8 +123,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     if feature_angle is not None:  # on the input's level, which then serves the refinement too
         angle = check_angle("feature_angle", feature_angle)
         level = checked_level(Fi, n, pairs)
-        feat = features_of_level(positions, level, angle) if len(Fi) else detect_features(positions, Fi, angle)
-        pairs, sharp, corner = merge_detected(feat, pairs, sharp, corner, n)
+        pairs, sharp, corner = merge_detected(features_of_level(positions, level, angle), pairs, sharp, corner, n)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(_SQRT3_TAGS)
     if scheme == "loop":
@@ -134,8 +133,9 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     cut = _cut(Fi, n, pairs, sharp) if cut_asked else None
     if cut is None:
         keep = sharp > 0
-        level = (level if level is not None else checked_level(Fi, n, pairs)).tag(pairs[keep], sharp[keep],
-                                                                                   face_sharp)
+        if level is None:
+            level = checked_level(Fi, n, pairs)
+        level = level.tag(pairs[keep], sharp[keep], face_sharp)
         return RefineInput(Fi, n, sharp_edges=pairs[keep], sharpness=sharp[keep], corner=corner, level=level,
                            uv=_with_uv_level(uv, level, corner), **common)
     cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)

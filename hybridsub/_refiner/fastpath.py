@@ -100,7 +100,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
-    if return_matrix or non_manifold == "cut":
+    if return_matrix or inp.cut is not None:  # a cut mesh's positions come through S_1 @ D
         r = refinement_of(inp)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)

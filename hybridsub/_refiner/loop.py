@@ -59,25 +59,26 @@ def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = T
     if inp.uv is not None:
         uvl, uv_fixed = inp.uv.level, inp.uv.corner
     for step in range(1, inp.levels + 1):
-        if uvl is None:
-            plan = plan_step(level, corner, inp.scheme, step, inp.loop_weights)
-            if budget is not None:
-                budget.check(step, level, plan)  # before this step allocates anything large
-            faces, child, offsets = child_level(level, plan, want_topology=topology_last or step < inp.levels)
-            yield Step(step, level, plan, faces, child, offsets, None)
-        else:
-            seams = (uvl.twin < 0) & (level.twin >= 0)  # the UV mesh is cut exactly along the seams
-            plan = plan_step(level, corner, inp.scheme, step, inp.loop_weights, force_split=seams)
+        # With UVs, seams are split (the UV mesh is cut exactly along them), and the UV mesh
+        # splits every edge the geometry splits, so both emit aligned faces.
+        seams = None if uvl is None else (uvl.twin < 0) & (level.twin >= 0)
+        plan = plan_step(level, corner, inp.scheme, step, inp.loop_weights, force_split=seams)
+        uv_plan = None
+        if uvl is not None:
             uv_plan = plan_step(uvl, uv_fixed, inp.scheme, step, inp.loop_weights,
                                 force_split=plan.hkind == R.EDGE_SPLIT)
             if not np.array_equal(uv_plan.hkind, plan.hkind):
                 raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
-            if budget is not None:
-                budget.check(step, level, plan, also=(uvl, uv_plan))
-            faces, child, offsets = child_level(level, plan)
+        if budget is not None:  # before this step allocates anything large
+            budget.check(step, level, plan, also=None if uvl is None else (uvl, uv_plan))
+        want = topology_last or step < inp.levels or uvl is not None
+        faces, child, offsets = child_level(level, plan, want_topology=want)
+        uv = None
+        if uvl is not None:
             uv_faces, uv_child, _ = child_level(uvl, uv_plan)
-            yield Step(step, level, plan, faces, child, offsets, UVStep(uvl, uv_plan, uv_faces, uv_child))
+            uv = UVStep(uvl, uv_plan, uv_faces, uv_child)
             uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
             uvl = uv_child
+        yield Step(step, level, plan, faces, child, offsets, uv)
         corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
         level = child

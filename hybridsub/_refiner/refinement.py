@@ -289,25 +289,25 @@ def _uv_step_matrix(inp: RefineInput, s: Step) -> sp.csr_matrix:
 
 
 def _unrefined(inp: RefineInput) -> Refinement:
-    """No faces: every level is the input."""
-    n, m = inp.n_vertices, inp.n_faces
-    ident = np.arange(m, dtype=np.int64)
+    """No faces: every level is the input (and with UVs, the UV index mesh likewise)."""
+    n, levels = inp.n_vertices, inp.levels
+    ident = np.arange(inp.n_faces, dtype=np.int64)
     mask = inp.faces_out(inp.face_sharp)
     corners = np.flatnonzero(inp.corner)
-    if inp.uv is None:
-        steps = [RefinementStep(inp.faces.copy(), sp.identity(n, format="csr"), inp.sharp_edges, inp.sharpness,
-                                mask, corners, ident) for _ in range(inp.levels)]
-        faces = steps[-1].faces if steps else inp.faces.copy()
-        return Refinement(faces, inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n, inp.max_memory)
-    T, t = inp.uv.faces, inp.uv.n_uvs
-    no_pairs, no_sharp, no_corners = np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64)
+    uv = uv_faces = None
+    if inp.uv is not None:
+        uv_faces, t = inp.uv.faces, inp.uv.n_uvs
+        no_pairs, no_sharp, no_corners = np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int64)
+        uv_steps = [RefinementStep(uv_faces.copy(), sp.identity(t, format="csr"), no_pairs, no_sharp, mask,
+                                   no_corners, ident) for _ in range(levels)]
+        uv = Refinement(uv_faces.copy(), no_pairs, no_sharp, mask, no_corners, ident.copy(), uv_steps, t,
+                        inp.max_memory)
     steps = [RefinementStep(inp.faces.copy(), sp.identity(n, format="csr"), inp.sharp_edges, inp.sharpness, mask,
-                            corners, ident, T.copy(), sp.identity(t, format="csr")) for _ in range(inp.levels)]
-    uv_steps = [RefinementStep(T.copy(), sp.identity(t, format="csr"), no_pairs, no_sharp, mask, no_corners, ident)
-                for _ in range(inp.levels)]
-    uv = Refinement(T.copy(), no_pairs, no_sharp, mask, no_corners, ident.copy(), uv_steps, t, inp.max_memory)
-    return Refinement(inp.faces.copy(), inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n,
-                      inp.max_memory, uv)
+                            corners, ident, None if uv is None else uv_faces.copy(),
+                            None if uv is None else sp.identity(inp.uv.n_uvs, format="csr"))
+             for _ in range(levels)]
+    faces = steps[-1].faces if steps else inp.faces.copy()
+    return Refinement(faces, inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n, inp.max_memory, uv)
 
 
 def _compose_cut(inp: RefineInput, r: Refinement) -> Refinement:
