@@ -9,17 +9,40 @@ Kobbelt's √3 and Loop with creases, as sparse refinement matrices.
 >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, scheme="sqrt3")
 >>> len(F2) == 3 * len(F)
 True
+
+The public names are imported on first use (PEP 562), so that ``hybridsub --help`` does not
+load NumPy, SciPy and Numba; ``from hybridsub import subdivide`` works as usual.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from ._errors import MeshError, OutputTooLargeError
-from ._input import Features, detect_features
-from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, limit_matrix,
-                       limit_normals, limit_positions, refine, refine_face_varying, seam_edges, set_memory_limit,
-                       subdivide, subdivide_face_varying)
-from ._io import TaggedMesh, load_example, read_mesh, write_mesh
-from ._app.batch import BatchSummary, batch
-from ._app.interop import subdivide_mesh
-from . import analysis
+from ._version import __version__ as __version__
+
+if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr__ below
+    from . import analysis
+    from ._app.batch import BatchSummary, batch
+    from ._app.interop import subdivide_mesh
+    from ._input import Features, detect_features
+    from ._io import TaggedMesh, load_example, read_mesh, write_mesh
+    from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, limit_matrix,
+                           limit_normals, limit_positions, refine, refine_face_varying, seam_edges,
+                           set_memory_limit, subdivide, subdivide_face_varying)
+
+#: Where each public name lives (imported when first used).
+_HOMES = {
+    "._refiner": ("FaceVaryingRefinement", "Refinement", "RefinementStep", "get_memory_limit", "limit_matrix",
+                  "limit_normals", "limit_positions", "refine", "refine_face_varying", "seam_edges",
+                  "set_memory_limit", "subdivide", "subdivide_face_varying"),
+    "._input": ("Features", "detect_features"),
+    "._io": ("TaggedMesh", "load_example", "read_mesh", "write_mesh"),
+    "._app.batch": ("BatchSummary", "batch"),
+    "._app.interop": ("subdivide_mesh",),
+}
+_HOME_OF = {name: home for home, names in _HOMES.items() for name in names}
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
@@ -28,4 +51,18 @@ __all__ = [
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
     "batch", "BatchSummary",
 ]
-from ._version import __version__ as __version__
+
+
+def __getattr__(name: str) -> Any:
+    if name == "analysis":
+        value: Any = importlib.import_module(".analysis", __name__)
+    elif name in _HOME_OF:
+        value = getattr(importlib.import_module(_HOME_OF[name], __name__), name)
+    else:
+        raise AttributeError(f"module 'hybridsub' has no attribute {name!r}")
+    globals()[name] = value  # once imported, a plain module attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

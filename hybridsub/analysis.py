@@ -258,14 +258,14 @@ class Smoothness(NamedTuple):
     subdominant : tuple of float
         λ₂, λ₃ (moduli).
     next : float
-        |λ₄|, the largest modulus below the sub-dominant pair.
+        ``|λ₄|``, the largest modulus below the sub-dominant pair.
     condition8 : bool
-        The paper's (8): λ₁ = 1 > λ₂ = λ₃ > |λᵢ|, i ≥ 4.
+        The paper's (8): λ₁ = 1 > λ₂ = λ₃ > ``|λᵢ|``, i ≥ 4.
     condition9 : bool
-        The paper's (9): λ₁ = 1 > λ₂ ≥ λ₃ > |λ₄| (λ₂ and λ₃ real).
+        The paper's (9): λ₁ = 1 > λ₂ ≥ λ₃ > ``|λ₄|`` (λ₂ and λ₃ real).
     crease_tangent : bool or None
         Crease sectors only: the crease curve's tangent eigenvalue (1/2 for Loop, 1/3 per
-        two √3 steps) is one of λ₂, λ₃ and above |λ₄|. Without it the two sub-dominant
+        two √3 steps) is one of λ₂, λ₃ and above ``|λ₄|``. Without it the two sub-dominant
         eigenvectors both vanish on the crease, the characteristic map is not injective and
         the sector has no tangent plane at the vertex, whatever (9) says.
     """

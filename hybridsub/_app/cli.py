@@ -9,29 +9,27 @@ stdout. Exit codes: 0 success, 1 the input or the run failed (one line naming th
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
-import logging
 import os
 import sys
 import time
 
-import numpy as np
-
-from .. import _io
+# Only what building the parser needs is imported here, so that `hybridsub --help` and a bad
+# command line answer without loading NumPy, SciPy and Numba; each command imports its own.
 from .._errors import MeshError
-from .._input import SCHEMES, count_of, detect_features
-from .._io import example_path
-from .._units import short_bytes
+from .._typing import SCHEMES
 from .._version import __version__
-from .batch import batch
-from .pipeline import (SCHEME_NAMES, FileOptions, PipelineError, check_memory, gather_features, keeps_uv, load_mesh,
-                       predict_file_levels, refine_mesh, say, seams, subdivide_file)
-from .report import mesh_report
+
+#: The documentation site (the guide and the API reference); pip does not install docs/.
+DOCS_URL = "https://hybridsub.readthedocs.io"
 
 
-def _file_options(a: argparse.Namespace, **changes) -> FileOptions:
+def _file_options(a: argparse.Namespace, **changes):
     """The pipeline's options from a command's arguments (those it has), with ``changes``."""
+    import dataclasses
+
+    from .pipeline import FileOptions
+
     given = {f.name: getattr(a, f.name) for f in dataclasses.fields(FileOptions) if hasattr(a, f.name)}
     return FileOptions(**{**given, **changes})
 
@@ -41,6 +39,8 @@ def _file_options(a: argparse.Namespace, **changes) -> FileOptions:
 
 
 def cmd_subdivide(a) -> int:
+    from .pipeline import PipelineError, subdivide_file
+
     if not os.path.splitext(a.output)[1]:
         raise PipelineError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .npz, .stl, .glb, …)")
     subdivide_file(_file_options(a), a.input, a.output)
@@ -48,6 +48,11 @@ def cmd_subdivide(a) -> int:
 
 
 def cmd_batch(a) -> int:
+    import logging
+
+    from .batch import batch
+    from .pipeline import PipelineError
+
     # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
     try:
@@ -66,6 +71,7 @@ def cmd_batch(a) -> int:
 
 def cmd_compare(a) -> int:
     from .figure import compare_panels, render_figure
+    from .pipeline import PipelineError, check_memory, gather_features, load_mesh, predict_file_levels, say
 
     if not a.output.lower().endswith(".png"):
         raise PipelineError(f"{a.output}: the figure is written as PNG; give a .png file name")
@@ -94,6 +100,8 @@ def cmd_compare(a) -> int:
 
 
 def _size(text: str) -> tuple[int, int]:
+    from .pipeline import PipelineError
+
     try:
         w, h = (int(x) for x in text.lower().split("x"))
     except ValueError:
@@ -104,6 +112,8 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def _view(text: str) -> tuple[float, float]:
+    from .pipeline import PipelineError
+
     try:
         az, el = (float(x) for x in text.split(","))
     except ValueError:
@@ -112,6 +122,13 @@ def _view(text: str) -> tuple[float, float]:
 
 
 def cmd_info(a) -> int:
+    import numpy as np
+
+    from .. import _io
+    from .._input import count_of
+    from .pipeline import load_mesh
+    from .report import mesh_report
+
     opts = _file_options(a)
     mesh = load_mesh(opts, a.input)
     rep = mesh_report(mesh.vertices, mesh.faces)
@@ -148,6 +165,8 @@ def cmd_info(a) -> int:
 
 def _problems(rep: dict) -> list[str]:
     """What ``info`` reports as wrong (or merely unusual) with a mesh, from its report."""
+    from .._input import count_of
+
     problems = []
     if rep["nonmanifold_edges"]:
         ex = ", ".join(f"{u}–{w}" for u, w in rep["nonmanifold_edge_examples"])
@@ -168,8 +187,12 @@ def _problems(rep: dict) -> list[str]:
     return problems
 
 
-def _info_subdivide(a, opts: FileOptions, mesh, lines: list[str], out: dict) -> None:
+def _info_subdivide(a, opts, mesh, lines: list[str], out: dict) -> None:
     """``info``'s lines on a valid mesh: detected features, texture, and what subdivide would make."""
+    from .._input import count_of, detect_features
+    from .._units import short_bytes
+    from .pipeline import gather_features, keeps_uv, predict_file_levels, seams
+
     angle = a.feature_angle if a.feature_angle is not None else 30.0
     det = detect_features(mesh.vertices, mesh.faces, angle)
     lines.append(f"  detected      {count_of(len(det.sharp_edges), 'crease')} (dihedral > {angle:g}°), "
@@ -203,7 +226,13 @@ def _emit(a, lines, out, code) -> int:
 
 
 def cmd_demo(a) -> int:
-    src = example_path()
+    import dataclasses
+
+    from .. import _io
+    from .._input import count_of
+    from .pipeline import SCHEME_NAMES, FileOptions, gather_features, refine_mesh
+
+    src = _io.example_path()
     os.makedirs(a.output, exist_ok=True)
     written = []
     mesh = _io.read_mesh(src)
@@ -317,7 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Subdivision surfaces that keep their sharp features: hybrid √3–Loop, Kobbelt √3, "
                     "Loop with creases.",
         epilog="Exit codes: 0 success, 1 the input or the run failed, 2 bad command line. "
-               "See docs/usage.md and docs/formats.md.")
+               f"Documentation (the guide and the API reference): {DOCS_URL}")
     ap.add_argument("--version", action="version", version=f"hybridsub {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo):
@@ -415,6 +444,8 @@ def _add_demo(sub) -> None:
 def main(argv=None) -> int:
     ap = build_parser()
     a = ap.parse_args(argv)
+    from .pipeline import PipelineError  # after parsing: --help and usage errors load nothing heavy
+
     try:
         return a.func(a)
     except PipelineError as e:

@@ -13,8 +13,7 @@ import numpy as np
 
 from .._rules import refinement as R
 from .._errors import MeshError
-
-SCHEMES = ("hybrid", "sqrt3", "loop")
+from .._typing import SCHEMES
 
 
 def check_options(scheme, levels, loop_weights) -> int:

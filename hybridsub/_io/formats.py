@@ -16,7 +16,7 @@ import warnings
 from numpy.typing import ArrayLike
 
 from .._errors import MeshError
-from .mesh import TaggedMesh, as_tagged, describe_tags
+from .mesh import TaggedMesh, as_tagged, check_read, describe_tags
 from .npz import read_npz, write_npz
 from .obj import read_obj, write_obj
 from .off import read_off_mesh, write_off
@@ -81,9 +81,7 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
         mesh = read_npz(path)
     else:
         mesh = read_trimesh(path, ext)
-    if len(mesh.faces) == 0:
-        raise MeshError(f"{path}: not a triangle mesh (it has no faces)")
-    return mesh
+    return check_read(path, mesh)
 
 
 

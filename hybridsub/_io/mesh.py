@@ -98,6 +98,30 @@ class TaggedMesh:
         return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces))
 
 
+def check_read(path: str, mesh: TaggedMesh) -> TaggedMesh:
+    """``mesh`` as read from ``path`` by any reader, checked where every format can go wrong
+    alike: faces present, three finite coordinates per vertex.
+
+    >>> check_read("t.off", TaggedMesh(np.array([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]]), np.array([[0, 1, 2]])))
+    Traceback (most recent call last):
+    ...
+    hybridsub._errors.MeshError: t.off: vertex 1 has a non-finite coordinate (nan): every coordinate must be a finite number
+    """
+    V = mesh.vertices
+    if len(mesh.faces) == 0:
+        raise MeshError(f"{path}: not a triangle mesh (it has no faces)")
+    if V.ndim != 2 or V.shape[1] != 3:
+        k = V.shape[1] if V.ndim == 2 else 1
+        raise MeshError(f"{path}: the vertices have {k} coordinate{'s' * (k != 1)}; a vertex needs three (x y z)")
+    finite = np.isfinite(V).all(axis=1)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
+        bad = V[i][~np.isfinite(V[i])][0]
+        raise MeshError(f"{path}: vertex {i} has a non-finite coordinate ({bad}): every coordinate must be a finite "
+                        "number" + (f" ({int((~finite).sum()):,} such vertices)" if (~finite).sum() > 1 else ""))
+    return mesh
+
+
 def sharpness_from_file(s: np.ndarray) -> np.ndarray:
     """Sharpness as read from a file: ``>= 10`` becomes ``inf``.
 

@@ -95,7 +95,9 @@ def _obj_fast_faces(f_lines):
     m = len(f_lines)
     try:
         nums = np.array(joined.replace("//", " ").replace("/", " ").split(), dtype=np.int64)
-    except ValueError:
+    except (ValueError, OverflowError):
+        return None
+    if not nums.all():  # an index 0: the careful reader names the line
         return None
     if nums.size != 3 * k * m or joined.count("/") != 3 * m * (len(parts) - 1):
         return None
@@ -134,14 +136,22 @@ def _obj_face(path: str, number: int, line: str, w: list, nv: int, nvt: int) -> 
     try:
         for corner in w[1:]:
             parts = corner.split("/")
-            i = int(parts[0])
-            vs.append(i - 1 if i > 0 else nv + i)
+            vs.append(_obj_index(int(parts[0]), nv, "vertex"))
             if len(parts) > 1 and parts[1]:
-                j = int(parts[1])
-                ts.append(j - 1 if j > 0 else nvt + j)
-    except ValueError:
-        raise MeshError(f"{path}: line {number}: cannot read face {line.strip()!r}") from None
+                ts.append(_obj_index(int(parts[1]), nvt, "texture coordinate"))
+    except ValueError as e:
+        why = f": {e}" if str(e).startswith("OBJ") else ""
+        raise MeshError(f"{path}: line {number}: cannot read face {line.strip()!r}{why}") from None
     return vs, ts
+
+
+def _obj_index(i: int, count: int, what: str) -> int:
+    """The 0-based index of OBJ index ``i`` (from 1; negative: back from the ``count`` read so far)."""
+    if i == 0:
+        raise ValueError(f"OBJ indices count from 1 (or back from -1); 0 is no {what}")
+    if i < 0 and count + i < 0:
+        raise ValueError(f"OBJ index {i} counts back past the first {what} ({count} read so far)")
+    return i - 1 if i > 0 else count + i
 
 
 class _ObjExtras:
@@ -201,9 +211,9 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
     uv, face_uv = _obj_uv(path, vt_rows, fuv, notes)
     if origin is not None:
         notes.append(f"triangulated {len(faces)} polygons into {len(F)} triangles")
-    check_faces(path, F, len(V), origin)
+    check_faces(path, F, len(V), origin, base=1)
     if face_uv is not None and uv is not None:
-        check_indices(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}")
+        check_indices(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}", base=1)
     edges, sharpness, corners, sharp_faces, tag_notes, boundary_corners = _parse_tags(path, extras.tags, len(V),
                                                                                       len(faces))
     if origin is not None and len(sharp_faces):

@@ -33,6 +33,10 @@ def read_trimesh(path: str, ext: str) -> TaggedMesh:
                         + ", ".join(sorted(set(trimesh.available_formats()))))
     try:
         loaded = trimesh.load(path, process=False, force="mesh")
+    except ImportError as e:  # trimesh guesses the text encoding of a damaged file with an optional module
+        raise MeshError(f"{path}: cannot read it as {kind.upper()}: the file is damaged or not {kind.upper()} "
+                        f"(trimesh wanted the optional module {e.name or 'it names'} to guess its text "
+                        "encoding)") from None
     except Exception as e:  # trimesh raises many kinds of errors on bad files
         raise MeshError(f"{path}: trimesh cannot read it: {type(e).__name__}: {e}") from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:

@@ -33,8 +33,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .edges import edge_keys, group_halfedges, halfedge_ends, next_halfedge
 from .errors import not_an_edge_error
@@ -78,6 +76,9 @@ def cut_non_manifold(F: np.ndarray, n: int, crease_vertices: np.ndarray | None =
     # Sectors: corners (3f + i, the corner at vertex F[f, i]) joined through proper edges.
     # Halfedge h = u→w (face f) and its twin t = w→u (face g): u's corners are h and next(t),
     # w's corners are next(h) and t.
+    import scipy.sparse as sp  # here: SciPy's graph module costs a third of a small run's start-up
+    from scipy.sparse.csgraph import connected_components
+
     h, t = a[proper], b[proper]
     links_a = np.concatenate([h, next_halfedge(h)])
     links_b = np.concatenate([next_halfedge(t), t])
