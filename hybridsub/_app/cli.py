@@ -71,6 +71,7 @@ def cmd_batch(a) -> int:
 
 def cmd_compare(a) -> int:
     from .figure import compare_panels, render_figure
+    from .._input import count_of
     from .pipeline import PipelineError, check_memory, gather_features, load_mesh, predict_file_levels, say
 
     if not a.output.lower().endswith(".png"):
@@ -83,7 +84,7 @@ def cmd_compare(a) -> int:
     say(opts, feat.summary)
     for scheme in ("hybrid", "loop"):
         check_memory(opts, predict_file_levels(mesh, a.levels, scheme, feat, uv=False),
-                     f"{a.levels} levels of {scheme}")
+                     f"{count_of(a.levels, 'level')} of {scheme}")
     t = time.perf_counter()
     try:
         panels = compare_panels(mesh.vertices, mesh.faces, a.levels, loop_weights=a.loop_weights, **feat.tags())

@@ -379,7 +379,7 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
                   "to keep them)")
     X = np.hstack(cols)
     pred = predict_file_levels(mesh, levels, scheme, feat, attributes=X.shape[1], path=path)
-    check_memory(opts, pred, f"{levels} levels of {scheme}")
+    check_memory(opts, pred, f"{count_of(levels, 'level')} of {scheme}")
     bar = ProgressBar([p["faces"] for p in pred], scheme, enabled=not opts.quiet and sys.stderr.isatty())
     uv_args = dict(uv=mesh.uv, face_uv=mesh.face_uv, uv_mode=opts.uv_mode or "linear") if keep_uv else {}
     try:
@@ -391,7 +391,7 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
     except OutputTooLargeError as e:  # the library's memory limit (HYBRIDSUB_MAX_MEMORY); --force lifts it
         raise PipelineError(f"{path}: {e}, or pass --force") from None
     except MemoryError:
-        raise PipelineError(f"out of memory refining {path} ({levels} levels of {scheme}); use fewer levels") from None
+        raise PipelineError(f"out of memory refining {path} ({count_of(levels, 'level')} of {scheme}); use fewer levels") from None
     finally:
         bar.close()
     return _refined_mesh(mesh, res, vc, keep_uv), res.seconds

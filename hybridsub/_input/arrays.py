@@ -43,6 +43,22 @@ def count_of(k: int, word: str) -> str:
     return f"{k:,} {word[:-2] + 'ices' if word.endswith('vertex') else word + 's'}"
 
 
+def tag_counts(sharp_edges, corners, sharp_faces=None) -> str:
+    """The tags of a result in words, for the ``repr`` of results (masks counted as indices).
+
+    >>> tag_counts(np.array([[0, 1]]), np.array([2]), np.array([True, False]))
+    '1 crease, 1 corner, 1 sharp face'
+    """
+    def count(a) -> int:
+        a = np.asarray(a)
+        return int(a.sum()) if a.dtype == bool else len(a)
+
+    parts = [count_of(count(sharp_edges), "crease"), count_of(count(corners), "corner")]
+    if sharp_faces is not None and count(sharp_faces):
+        parts.append(count_of(count(sharp_faces), "sharp face"))
+    return ", ".join(parts)
+
+
 def check_non_manifold(non_manifold) -> str:
     if not isinstance(non_manifold, str) or non_manifold not in NON_MANIFOLD:
         raise ValueError(f"non_manifold must be one of {NON_MANIFOLD}, got {non_manifold!r}")
@@ -187,6 +203,10 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
         if sharpness is not None and np.size(sharpness):
             raise ValueError("sharpness was given without sharp_edges")
         return np.empty((0, 2), np.int64), np.empty(0)
+    if isinstance(sharp_edges, (int, np.integer)) and not isinstance(sharp_edges, bool):
+        # subdivide(V, F, 2), as igl and trimesh are called: the number lands on sharp_edges
+        raise TypeError(f"sharp_edges (the argument after the faces) got the number {sharp_edges}: it takes (k, 2) "
+                        f"vertex pairs, and levels comes after it — pass levels={sharp_edges} by keyword")
     E = as_array(sharp_edges, "sharp_edges", 2, "row")
     if E.size == 0:
         E = E.reshape(0, 2)

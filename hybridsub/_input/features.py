@@ -12,6 +12,7 @@ import numpy as np
 
 from .._topology import Level, checked_level
 from . import arrays as val
+from .arrays import count_of
 from .._topology import edge_keys
 from .._typing import ArrayLike
 
@@ -35,6 +36,10 @@ class Features(NamedTuple):
     sharp_edges: np.ndarray
     boundary_edges: np.ndarray
     corners: np.ndarray
+
+    def __repr__(self) -> str:
+        return (f"Features({count_of(len(self.sharp_edges), 'sharp edge')}, "
+                f"{count_of(len(self.boundary_edges), 'boundary edge')}, {count_of(len(self.corners), 'corner')})")
 
 
 def check_angle(name: str, a) -> float:

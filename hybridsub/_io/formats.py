@@ -10,7 +10,9 @@ tag conventions are in ``docs/formats.md``.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import tempfile
 import warnings
 
 from numpy.typing import ArrayLike
@@ -138,17 +140,42 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     """Write ``mesh`` (the format by the extension of ``path``, missing folders created); returns
     a description of the tags the format could not hold ('' if none).
 
+    The file is written under a temporary name in the same folder and renamed onto ``path``
+    when complete, so a failed write (a full disk, a file-size limit, an unknown format) leaves
+    no partial file, and an existing ``path`` stays as it was; the error names ``path``.
+
     Examples
     --------
     >>> import numpy as np, os, tempfile
     >>> m = TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), corners=np.array([2]))
     >>> d = tempfile.mkdtemp()
     >>> write(os.path.join(d, "t.obj"), m), write(os.path.join(d, "t.stl"), m)
-    ('', '1 corners')
+    ('', '1 corner')
+    >>> sorted(os.listdir(d))
+    ['t.obj', 't.stl']
     """
     d = os.path.dirname(os.path.abspath(path))
     os.makedirs(d, exist_ok=True)
     ext = os.path.splitext(path)[1].lower()
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=f".partial{ext}", dir=d)
+    os.close(fd)
+    try:
+        dropped = _write_format(tmp, mesh, ext, binary)
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException as e:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        if isinstance(e, OSError) and e.strerror and e.filename != path:
+            raise OSError(e.errno, e.strerror, path) from None  # the caller's name, not the temporary one
+        if isinstance(e, MeshError):
+            raise MeshError(str(e).replace(tmp, path)) from None
+        raise
+    return dropped
+
+
+def _write_format(path: str, mesh: TaggedMesh, ext: str, binary: bool) -> str:
+    """Write ``mesh`` to ``path`` as format ``ext``; returns the tags the format cannot hold."""
     if ext == ".obj":
         write_obj(path, mesh)
         return ""
@@ -164,3 +191,9 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
         write_trimesh(path, mesh, ext)
     return describe_tags(mesh)
 
+
+def _umask() -> int:
+    """The process's umask (mkstemp makes files readable by their owner only)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

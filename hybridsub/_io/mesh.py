@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import MeshError
-from .._input import as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices
+from .._input import as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices, count_of, tag_counts
 from .._rules import INFINITE_SHARPNESS
 
 #: Sharpness written for infinitely sharp creases and corners (OpenSubdiv's convention:
@@ -92,6 +92,13 @@ class TaggedMesh:
         out = np.zeros((n, 2))
         out[used] = self.uv[first[used]]
         return out
+
+    def __repr__(self) -> str:
+        extra = [what for what, there in (("vertex colours", self.vertex_colors is not None),
+                                          ("UVs", self.uv is not None), ("materials", bool(self.materials))) if there]
+        return (f"<TaggedMesh: {count_of(len(self.vertices), 'vertex')}, {count_of(len(self.faces), 'triangle')}; "
+                f"{tag_counts(self.sharp_edges, self.corners, self.sharp_faces)}"
+                + "".join(f"; {e}" for e in extra) + ">")
 
     @property
     def has_tags(self) -> bool:
@@ -206,14 +213,14 @@ def describe_tags(mesh: TaggedMesh) -> str:
     >>> import numpy as np
     >>> m = TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), sharp_edges=np.array([[0, 1]]), corners=np.array([2]))
     >>> describe_tags(m)
-    '1 creases, 1 corners'
+    '1 crease, 1 corner'
     """
     parts = []
     if len(mesh.sharp_edges):
-        parts.append(f"{len(mesh.sharp_edges):,} creases")
+        parts.append(count_of(len(mesh.sharp_edges), "crease"))
     if len(mesh.corners):
-        parts.append(f"{len(mesh.corners):,} corners")
+        parts.append(count_of(len(mesh.corners), "corner"))
     if len(mesh.sharp_faces):
-        parts.append(f"{len(mesh.sharp_faces):,} sharp faces")
+        parts.append(count_of(len(mesh.sharp_faces), "sharp face"))
     return ", ".join(parts)
 

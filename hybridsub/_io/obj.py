@@ -14,6 +14,7 @@ import os
 import numpy as np
 
 from .._errors import MeshError
+from .._input import count_of
 from .._topology import group_halfedges, halfedge_ends
 from .._version import __version__
 from .mesh import INFINITE, TaggedMesh, describe_tags, sharpness_from_file, sharpness_to_file, unit_colors
@@ -210,7 +211,7 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
         F, origin = triangulate_polygons(path, faces, triangulate)
     uv, face_uv = _obj_uv(path, vt_rows, fuv, notes)
     if origin is not None:
-        notes.append(f"triangulated {len(faces)} polygons into {len(F)} triangles")
+        notes.append(f"triangulated {count_of(len(faces), 'polygon')} into {count_of(len(F), 'triangle')}")
     check_faces(path, F, len(V), origin, base=1)
     if face_uv is not None and uv is not None:
         check_indices(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}", base=1)

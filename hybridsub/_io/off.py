@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import MeshError
+from .._input import count_of
 from .mesh import TaggedMesh, unit_colors
 from .tables import check_faces, text_rows, triangulate_polygons
 
@@ -24,7 +25,7 @@ def read_off_mesh(path: str, triangulate: bool) -> TaggedMesh:
     >>> _ = open(path, "w").write("OFF\\n4 1 0\\n0 0 0\\n1 0 0\\n1 1 0\\n0 1 0\\n4 0 1 2 3\\n")
     >>> m = read_off_mesh(path, True)
     >>> m.faces.tolist(), m.notes
-    ([[0, 1, 2], [0, 2, 3]], ('triangulated 1 polygons into 2 triangles',))
+    ([[0, 1, 2], [0, 2, 3]], ('triangulated 1 polygon into 2 triangles',))
     """
     with open(path, encoding="utf-8", errors="replace") as fh:
         lines = [ln.split("#", 1)[0].split() for ln in fh]
@@ -54,7 +55,7 @@ def read_off_mesh(path: str, triangulate: bool) -> TaggedMesh:
         colors = unit_colors(A[:, 3:7])
     F, origin = triangulate_polygons(path, polys, triangulate)
     check_faces(path, F, nv, origin)
-    notes = (f"triangulated {nf} polygons into {len(F)} triangles",) if origin is not None else ()
+    notes = (f"triangulated {count_of(nf, 'polygon')} into {count_of(len(F), 'triangle')}",) if origin is not None else ()
     return TaggedMesh(V, F, vertex_colors=colors, notes=notes)
 
 

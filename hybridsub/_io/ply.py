@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import MeshError
+from .._input import count_of
 from .._version import __version__
 from .mesh import INFINITE, TaggedMesh, color_bytes, sharpness_from_file, sharpness_to_file
 from .tables import check_faces, triangulate_polygons
@@ -303,7 +304,7 @@ def read_ply_mesh(path: str, triangulate: bool) -> TaggedMesh:
         F, origin = triangulate_polygons(path, [list(map(int, p)) for p in polys], triangulate)
     check_faces(path, F, n, origin)
     uv, face_uv = _ply_uv(el["vertex"].data, fd, F, origin)
-    notes = [f"triangulated {len(polys)} polygons into {len(F)} triangles"] if origin is not None else []
+    notes = [f"triangulated {count_of(len(polys), 'polygon')} into {count_of(len(F), 'triangle')}"] if origin is not None else []
     E, s = _ply_creases(path, el, n)
     C = _ply_corners(path, el, n)
     S = _ply_sharp_faces(path, el, len(polys), origin)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .._input import RefineInput, as_data, open_gate
+from .._input import RefineInput, as_data, count_of, open_gate, tag_counts
 from .._topology import child_creases, face_parents
 from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .budget import Budget, check_product
@@ -64,6 +64,12 @@ class RefinementStep:
         """Number of vertices of level k + 1."""
         return self.matrix.shape[0]
 
+    def __repr__(self) -> str:
+        uv = f"; {count_of(self.uv_matrix.shape[0], 'UV value')}" if self.uv_matrix is not None else ""
+        return (f"<RefinementStep: from {count_of(self.matrix.shape[1], 'vertex')}: {count_of(len(self.faces), 'face')}, "
+                f"{count_of(self.n_vertices, 'vertex')}; {tag_counts(self.sharp_edges, self.corners, self.sharp_faces)}"
+                f"{uv}>")
+
 
 @dataclass(frozen=True, eq=False)
 class Refinement:
@@ -111,6 +117,12 @@ class Refinement:
     @property
     def n_vertices(self) -> int:
         return self.steps[-1].n_vertices if self.steps else self.n_coarse
+
+    def __repr__(self) -> str:
+        uv = "" if self.uv_refinement is None else f"; UVs: {count_of(self.uv_refinement.n_vertices, 'value')}"
+        return (f"<Refinement: {count_of(len(self.steps), 'level')} from {count_of(self.n_coarse, 'vertex')}: "
+                f"{count_of(len(self.faces), 'face')}, {count_of(self.n_vertices, 'vertex')}; "
+                f"{tag_counts(self.sharp_edges, self.corners, self.sharp_faces)}{uv}>")
 
     @property
     def uv_faces(self) -> np.ndarray | None:
