@@ -43,6 +43,7 @@ _HOMES = {
     "._app.interop": ("subdivide_mesh",),
 }
 _HOME_OF = {name: home for home, names in _HOMES.items() for name in names}
+_SUBMODULES = ("_app", "_io", "_refiner", "_input", "_topology", "_rules", "_jit", "_typing", "_units")
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
@@ -58,6 +59,8 @@ def __getattr__(name: str) -> Any:
         value: Any = importlib.import_module(".analysis", __name__)
     elif name in _HOME_OF:
         value = getattr(importlib.import_module(_HOME_OF[name], __name__), name)
+    elif name.startswith("_") and not name.startswith("__") and name in _SUBMODULES:
+        value = importlib.import_module("." + name, __name__)  # hybridsub._io as an attribute, as before
     else:
         raise AttributeError(f"module 'hybridsub' has no attribute {name!r}")
     globals()[name] = value  # once imported, a plain module attribute

@@ -289,7 +289,9 @@ def test_weld_untextured_triangle_soup(cube):
     r = hybridsub.refine(F, levels=2)
     want = np.clip(np.round(r.apply(rgb.astype(float))), 0, 255)
     assert np.array_equal(out.visual.vertex_colors[out.faces], want[F2])
-    assert len(hybridsub.subdivide_mesh(soup, 1).faces) == 6 * len(F)  # not welded by default: lone triangles
+    # welded by default too (a soup, as trimesh.load("part.stl", process=False) gives); weld=False: lone triangles
+    assert np.array_equal(hybridsub.subdivide_mesh(soup, 2).vertices, out.vertices)
+    assert len(hybridsub.subdivide_mesh(soup, 1, weld=False).faces) == 6 * len(F)
 
 
 def test_textured_welding_limits(textured_cube):

@@ -70,7 +70,9 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     weld : bool, optional
         Merge vertices at exactly equal positions (bit for bit, as exporters write both
         copies of a seam vertex) before refining, as described above. Default: True for a
-        mesh with per-vertex texture coordinates, else False. Two parts that touch at a vertex
+        mesh with per-vertex texture coordinates or with vertices at equal positions (a
+        triangle soup, such as ``trimesh.load("part.stl", process=False)``, which would
+        otherwise be refined as separate triangles), else False. Two parts that touch at a vertex
         are joined there (a bow-tie, refined as a corner); parts that share an edge or a face
         make the welded mesh invalid, which raises ``MeshError`` — pass ``weld=False`` for
         such a mesh.
@@ -126,8 +128,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
         sharp_edges, sharpness = stored.get("sharp_edges"), stored.get("sharpness")
         sharp_faces, corners = stored.get("sharp_faces"), stored.get("corners")
     uv = _vertex_uv(mesh)
-    if weld is None:
-        weld = uv is not None
+    if weld is None:  # a triangle soup (STL loaded with process=False) or a textured mesh's seam copies
+        weld = uv is not None or len(np.unique(V, axis=0)) < n
     if not isinstance(weld, (bool, np.bool_)):
         raise TypeError(f"weld must be True, False or None, got {weld!r}")
     data = _vertex_arrays(mesh, n)

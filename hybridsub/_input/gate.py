@@ -21,7 +21,7 @@ import numpy as np
 
 from .._topology import Cut, Level, checked_level, cut_non_manifold, duplicate_faces_error, map_sharp_edges, uv_start
 from . import arrays as val
-from .features import check_angle, features_of_level, merge_detected
+from .features import Features, check_angle, features_of_level, merge_detected
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,8 +122,12 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     level = None
     if feature_angle is not None:  # on the input's level, which then serves the refinement too
         angle = check_angle("feature_angle", feature_angle)
-        level = checked_level(Fi, n, pairs)
-        pairs, sharp, corner = merge_detected(features_of_level(positions, level, angle), pairs, sharp, corner, n)
+        if cut_asked:
+            feat, level = _features_after_cut(positions, Fi, n, pairs, sharp, angle)
+        else:
+            level = checked_level(Fi, n, pairs)
+            feat = features_of_level(positions, level, angle)
+        pairs, sharp, corner = merge_detected(feat, pairs, sharp, corner, n)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(_SQRT3_TAGS)
     if scheme == "loop":
@@ -154,6 +158,19 @@ def _with_uv_level(uv: UVInput | None, level: Level, corner: np.ndarray) -> UVIn
         return uv
     uvl, uv_corner = uv_start(level, uv.faces, uv.n_uvs, corner)
     return UVInput(uv.faces, uv.n_uvs, uv.mode, uvl, uv_corner)
+
+
+def _features_after_cut(V, Fi, n, pairs, sharp, angle) -> tuple[Features, Level | None]:
+    """``feature_angle=`` under ``non_manifold="cut"``: features found on the cut mesh (each
+    copy at its vertex's position), as input vertex indices, since the input itself may have no
+    consistent orientation to measure angles by; and the input's level when nothing is cut."""
+    cut = _cut(Fi, n, pairs, sharp)
+    if cut is None:
+        level = checked_level(Fi, n, pairs)
+        return features_of_level(V, level, angle), level
+    o = cut.origin
+    f = features_of_level(V[o], checked_level(cut.faces, cut.n_vertices), angle)
+    return Features(o[f.sharp_edges], o[f.boundary_edges], np.unique(o[f.corners])), None
 
 
 def _cut(Fi: np.ndarray, n: int, pairs: np.ndarray, sharp: np.ndarray) -> Cut | None:

@@ -26,13 +26,14 @@ See ``docs/face_varying.md``.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Literal, NamedTuple, overload
 
 import numpy as np
+import scipy.sparse as sp
 
 from .._input import as_uv_values, as_vertices, open_gate
 from .._topology import seam_halfedges
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
+from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
 from .fastpath import walk_data
 from .refinement import Refinement, refine
 
@@ -146,12 +147,33 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     return FaceVaryingRefinement(geo, geo.uv_refinement)
 
 
+_Textured = tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64]]
+
+
+@overload
+def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: ArrayLike,
+                           sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = ...,
+                           uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
+                           corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
+                           return_matrix: Literal[False] = ..., max_memory: MemoryLimit = ...) -> _Textured: ...
+
+
+@overload
+def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: ArrayLike,
+                           sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = ...,
+                           uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
+                           corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
+                           return_matrix: Literal[True], max_memory: MemoryLimit = ...,
+                           ) -> tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64],
+                                      sp.csr_matrix, sp.csr_matrix]: ...
+
+
 def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: ArrayLike,
                            sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = "hybrid",
                            uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                            sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                            loop_weights: LoopWeights = "loop", return_matrix: bool = False,
-                           max_memory: MemoryLimit = None) -> tuple:
+                           max_memory: MemoryLimit = None) -> tuple:  # see the overloads above
     """Subdivide a textured triangle mesh: positions and UVs with seams, faces kept aligned.
 
     Parameters

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Literal, overload
 
 import numpy as np
 import scipy.sparse as sp
@@ -28,13 +29,32 @@ from .refinement import refinement_of
 from .stencils import apply_step
 
 
+Positions = NDArray[np.floating]
+Faces = NDArray[np.int64]
+
+
+@overload
+def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+              scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
+              corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[False] = ...,
+              feature_angle: float | None = ..., non_manifold: NonManifold = ...,
+              max_memory: MemoryLimit = ...) -> tuple[Positions, Faces]: ...
+
+
+@overload
+def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+              scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
+              corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[True],
+              feature_angle: float | None = ..., non_manifold: NonManifold = ...,
+              max_memory: MemoryLimit = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
+
+
 def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
               max_memory: MemoryLimit = None,
-              ) -> tuple[NDArray[np.floating], NDArray[np.int64]] | tuple[NDArray[np.floating], NDArray[np.int64],
-                                                                          sp.csr_matrix]:
+              ) -> tuple[Positions, Faces] | tuple[Positions, Faces, sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
     Parameters
