@@ -312,7 +312,7 @@ def _connect(scheduler, workers: int | None, quiet: bool):
     return client, [client, cluster], f"a local cluster of {count_of(n, 'worker')}"
 
 
-def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str | os.PathLike, *, levels: int = 3,
+def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str | os.PathLike, *, levels: int = 1,
           scheme: Scheme = "hybrid", feature_angle: float | None = None, feature_sharpness: float | None = None,
           format: str = "obj", loop_weights: LoopWeights = "loop", ignore_tags: bool = False,
           triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, force: bool = False,

@@ -80,7 +80,7 @@ def cmd_compare(a) -> int:
     view = _view(a.view) if a.view else None
     opts = _file_options(a)
     mesh = load_mesh(opts, a.input)
-    feat = gather_features(opts, mesh, a.input, default_angle=30.0)
+    feat = gather_features(opts, mesh, a.input)
     say(opts, feat.summary)
     for scheme in ("hybrid", "loop"):
         check_memory(opts, predict_file_levels(mesh, a.levels, scheme, feat, uv=False),
@@ -362,7 +362,7 @@ def _add_subdivide(sub) -> None:
                                    "propagated, when the output is OBJ or PLY.")
     s.add_argument("input", metavar="IN")
     s.add_argument("-o", "--output", metavar="OUT", required=True, help="output file; its extension picks the format")
-    s.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
+    s.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     _tag_options(s)
     _uv_option(s)
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
@@ -384,7 +384,7 @@ def _add_batch(sub) -> None:
     b.add_argument("inputs", metavar="INPUT", nargs="+", help="mesh files, folders and glob patterns")
     b.add_argument("-o", "--output", metavar="OUTDIR", required=True,
                    help="output folder; outputs mirror the inputs' names below their folder or pattern")
-    b.add_argument("--levels", type=_levels, default=3, help="subdivision steps (default: 3)")
+    b.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     b.add_argument("--format", choices=("obj", "ply", "npz"), default="obj",
                    help="output format (default: obj); all three keep the tags")
     _tag_options(b, tag_files=False)
@@ -407,10 +407,11 @@ def _add_compare(sub) -> None:
     c = sub.add_parser("compare", help="render input, √3, hybrid and Loop side by side into a PNG",
                        description="The paper's figures 4–6: the input with its sharp edges in red (semi-sharp in "
                                    "orange), Kobbelt √3, hybrid and Loop, same view, flat shaded, face counts "
-                                   "under each. Without tags or feature options, creases are detected at 30°.")
+                                   "under each. Creases are those of the file's tags and the feature options, as in 'subdivide' "
+                                   "(--feature-angle 30 detects them).")
     c.add_argument("input", metavar="IN")
     c.add_argument("-o", "--output", metavar="FIG.png", required=True)
-    c.add_argument("--levels", type=_levels, default=2, help="subdivision steps (default: 2)")
+    c.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     _tag_options(c, scheme=False)
     c.add_argument("--view", metavar="AZ,EL", help="turntable view in degrees (default: chosen to show the creases)")
     c.add_argument("--size", default="1600x520", metavar="WxH", help="figure size in pixels (default: 1600x520)")
@@ -426,7 +427,7 @@ def _add_info(sub) -> None:
                                    "orientation, valence histogram, detected features, and the faces, vertices "
                                    "and memory of each level subdivide would produce with the same options.")
     i.add_argument("input", metavar="IN")
-    i.add_argument("--levels", type=_levels, default=3, help="levels to predict (default: 3)")
+    i.add_argument("--levels", type=_levels, default=1, help="levels to predict (default: 1)")
     _tag_options(i)
     i.add_argument("--json", action="store_true", help="machine-readable output")
     i.set_defaults(func=cmd_info, quiet=False)
@@ -437,7 +438,7 @@ def _add_demo(sub) -> None:
                        description="Runs without arguments: writes fandisk subdivided by each scheme (OBJ with "
                                    "crease tags) and the comparison figure, and says where.")
     d.add_argument("-o", "--output", default="hybridsub-demo", help="output folder (default: ./hybridsub-demo)")
-    d.add_argument("--levels", type=_levels, default=2, help="subdivision steps (default: 2)")
+    d.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     d.add_argument("-q", "--quiet", action="store_true", help="only the list of files written")
     d.set_defaults(func=cmd_demo)
 

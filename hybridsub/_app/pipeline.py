@@ -66,7 +66,7 @@ class FileOptions:
     ('hybrid', 'loop')
     """
 
-    levels: int = 3
+    levels: int = 1
     scheme: str = "hybrid"
     feature_angle: float | None = None
     feature_sharpness: float | None = None
@@ -152,10 +152,9 @@ class _Sources:
     names: list = field(default_factory=list)
 
 
-def gather_features(opts: FileOptions, mesh: TaggedMesh, path: str,
-                    default_angle: float | None = None) -> FileFeatures:
+def gather_features(opts: FileOptions, mesh: TaggedMesh, path: str) -> FileFeatures:
     """Tags from the file, the tag files and the feature angle, checked and merged; one-line
-    summary. ``default_angle``: the angle to detect at when no tags are given at all."""
+    summary. Creases are detected only when ``opts.feature_angle`` asks (every command alike)."""
     n = len(mesh.vertices)
     edges = undirected_edges(mesh.faces, n)
     n_boundary = int((edges.count == 1).sum())
@@ -171,8 +170,6 @@ def gather_features(opts: FileOptions, mesh: TaggedMesh, path: str,
         src.names.append(f"tags in {os.path.basename(path)}")
     _read_tag_files(opts, mesh, path, edges.pairs, src)
     angle = opts.feature_angle
-    if angle is None and default_angle is not None and not src.edges and not src.sharp_faces and not src.corners:
-        angle = default_angle
     if angle is None and opts.feature_sharpness is not None:
         raise PipelineError("--feature-sharpness sets the sharpness of detected creases: give --feature-angle too")
     if angle is not None:
@@ -394,11 +391,12 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
         raise PipelineError(f"out of memory refining {path} ({count_of(levels, 'level')} of {scheme}); use fewer levels") from None
     finally:
         bar.close()
-    return _refined_mesh(mesh, res, vc, keep_uv), res.seconds
+    return _refined_mesh(mesh, res, vc, keep_uv, scheme), res.seconds
 
 
-def _refined_mesh(mesh: TaggedMesh, res, vc, keep_uv: bool) -> TaggedMesh:
-    """The refined positions, colours, UVs, tags and materials as a :class:`TaggedMesh`."""
+def _refined_mesh(mesh: TaggedMesh, res, vc, keep_uv: bool, scheme: str) -> TaggedMesh:
+    """The refined positions, colours, UVs, tags and materials as a :class:`TaggedMesh`. Sharp
+    faces only where the scheme tells them apart (``"hybrid"``): Loop splits every face alike."""
     Y = res.X
     V = np.ascontiguousarray(Y[:, :3])
     colors = uv = face_uv = None
@@ -406,7 +404,7 @@ def _refined_mesh(mesh: TaggedMesh, res, vc, keep_uv: bool) -> TaggedMesh:
         colors = np.clip(Y[:, 3:3 + vc.shape[1]], 0, 1)
     if keep_uv:
         uv, face_uv = res.uv, res.face_uv
-    sf = res.sharp_faces
+    sf = res.sharp_faces if scheme == "hybrid" else np.empty(0, np.int64)
     fm = None if mesh.face_material is None else mesh.face_material[res.face_parent]
     return TaggedMesh(V, res.faces, res.sharp_edges, res.sharpness, res.corners,
                       np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv,
