@@ -100,8 +100,10 @@ def test_error_messages(tmp_path, capsys):
 
 def test_compare_writes_the_figure(tmp_path):
     fig = tmp_path / "cmp.png"
-    r = run("compare", off("cube-meshed"), "-o", fig, "--levels", 1, "--size", "640x300", "--view", "30,25")
+    r = run("compare", off("cube-meshed"), "-o", fig, "--levels", 1, "--size", "640x300", "--view", "30,25",
+            "--feature-angle", 30)
     assert r.returncode == 0, r.stderr
+    assert "features: 192 creases, 8 corners — from dihedral angle > 30°" in r.stderr  # asked for, never guessed
     assert "faces: input 1,728, Kobbelt √3 5,184, hybrid √3–Loop 5,568, Loop 6,912" in r.stderr
     data = fig.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
@@ -120,7 +122,7 @@ def test_compare_writes_the_figure(tmp_path):
 
 
 def test_demo_runs_without_arguments(tmp_path):
-    r = run("demo", "-o", tmp_path / "d", "--levels", 1)
+    r = run("demo", "-o", tmp_path / "d")  # one level by default, as everywhere
     assert r.returncode == 0, r.stderr
     assert f"wrote 4 files to {tmp_path / 'd'}" in r.stdout
     for name in ("fandisk.hybrid.L1.obj", "fandisk.sqrt3.L1.obj", "fandisk.loop.L1.obj", "fandisk_compare.png"):
@@ -274,7 +276,7 @@ def test_colors_are_refined(tmp_path, capsys):
 
 
 def test_info(capsys):
-    assert main(["info", off("elephant-with-holes"), "--feature-angle", "40"]) == 0
+    assert main(["info", off("elephant-with-holes"), "--feature-angle", "40", "--levels", "3"]) == 0
     out = capsys.readouterr().out
     assert "2,798 vertices, 4,463 triangles, 7,371 edges" in out
     assert "106 loops, 1,353 edges" in out and "Euler characteristic -110, genus 3" in out
