@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import uuid
 import warnings
 
 from numpy.typing import ArrayLike
@@ -157,11 +157,10 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     d = os.path.dirname(os.path.abspath(path))
     os.makedirs(d, exist_ok=True)
     ext = os.path.splitext(path)[1].lower()
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=f".partial{ext}", dir=d)
-    os.close(fd)
+    # a fresh name beside the destination (same folder: the rename is atomic, relative links hold)
+    tmp = os.path.join(d, f".{os.path.basename(path)}.{uuid.uuid4().hex[:12]}.partial{ext}")
     try:
         dropped = _write_format(tmp, mesh, ext, binary)
-        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException as e:
         with contextlib.suppress(OSError):
@@ -190,10 +189,3 @@ def _write_format(path: str, mesh: TaggedMesh, ext: str, binary: bool) -> str:
     else:
         write_trimesh(path, mesh, ext)
     return describe_tags(mesh)
-
-
-def _umask() -> int:
-    """The process's umask (mkstemp makes files readable by their owner only)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
