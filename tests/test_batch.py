@@ -34,7 +34,7 @@ KW = dict(levels=2, feature_angle=30)
 BROKEN = {
     "broken/garbage.obj": "not a triangle mesh",
     "broken/fin.off": "is shared by 3 faces",
-    "broken/range.obj": "face 1 refers to vertex index 8",
+    "broken/range.obj": "face 1 refers to vertex 9, but there are only 3 (valid 1..3)",
     "broken/quad.obj": "has 4 vertices",
     "broken/truncated.ply": "truncated.ply",
     "broken/nofaces.npz": "needs arrays 'vertices' and 'faces'",
