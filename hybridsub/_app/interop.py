@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from .. import _input as val
-from .._io import classes
+from .._io import METADATA_KEY, classes
 from .._errors import MeshError
 from .._input import detect_features, merge_edges
 from .._refiner import Refinement, refine
@@ -15,9 +15,6 @@ from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
-
-#: Key of ``Trimesh.metadata`` under which ``subdivide_mesh`` stores the propagated tags.
-METADATA_KEY = "hybridsub"
 
 
 def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "hybrid",
