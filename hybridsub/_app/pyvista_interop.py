@@ -55,6 +55,6 @@ def trimesh_as_polydata(mesh, uv_name: str | None):
         out.point_data[uv_name or "TCoords"] = np.asarray(uv, np.float64)
         out.point_data.active_texture_coordinates_name = uv_name or "TCoords"
     for k, a in mesh.metadata.get(METADATA_KEY, {}).items():
-        if k in TAG_NAMES or k == "face_parent":
+        if (k in TAG_NAMES or k == "face_parent") and np.size(a):  # pyvista refuses empty arrays
             out.field_data[k] = np.asarray(a)
     return out

@@ -25,7 +25,7 @@ from .off import read_off_mesh, write_off
 from .ply import read_ply_mesh, write_ply_mesh
 from .convert import from_pyvista, from_trimesh, kind_of
 from .meshio_formats import meshio_knows, read_meshio, write_meshio
-from .trimesh_formats import read_trimesh, trimesh_reads, trimesh_writes, write_trimesh
+from .trimesh_formats import read_trimesh, write_trimesh
 
 
 def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMesh:
@@ -83,10 +83,10 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
         mesh = read_off_mesh(path, triangulate)
     elif ext == ".npz":
         mesh = read_npz(path)
-    elif trimesh_reads(ext) or not meshio_knows(_meshio_ext(path)):
-        mesh = read_trimesh(path, ext)
-    else:
+    elif _through_meshio(path):
         mesh = read_meshio(path, triangulate)
+    else:
+        mesh = read_trimesh(path, ext)
     if len(mesh.faces) == 0:
         raise MeshError(f"{path}: not a triangle mesh (it has no faces)")
     return mesh
@@ -205,11 +205,19 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
         return ""
     if ext == ".off":
         write_off(path, mesh)
-    elif trimesh_writes(ext) or not meshio_knows(_meshio_ext(path)):
-        write_trimesh(path, mesh, ext)
-    else:
+    elif _through_meshio(path):
         return write_meshio(path, mesh)
+    else:
+        write_trimesh(path, mesh, ext)
     return describe_tags(mesh)
+
+
+def _through_meshio(path: str) -> bool:
+    """Whether hybridsub reads and writes ``path`` through meshio: every format meshio knows
+    but STL, which trimesh reads (and welds) itself. (trimesh hands VTK, VTU, XDMF, … to meshio
+    as well, but with the triangles alone: read directly, the tag cells come along.)"""
+    ext = _meshio_ext(path)
+    return ext != ".stl" and meshio_knows(ext)
 
 
 def _meshio_ext(path: str) -> str:

@@ -169,7 +169,8 @@ class TaggedMesh:
         elif kind == "texture" and getattr(t.visual, "uv", None) is not None:
             poly.active_texture_coordinates = np.asarray(t.visual.uv, np.float64)
         for k, a in t.metadata[METADATA_KEY].items():
-            poly.field_data[k] = a
+            if np.size(a):  # pyvista refuses empty arrays: an absent tag means none
+                poly.field_data[k] = a
         return poly
 
 

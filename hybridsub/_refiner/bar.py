@@ -22,7 +22,7 @@ def level_bar(levels: int, progress: bool | None, desc: str) -> Any:
         return nullcontext()
     from tqdm.auto import tqdm
 
-    return tqdm(total=levels, desc=desc, unit="level", leave=False)
+    return tqdm(total=levels, desc=desc, unit="level", leave=False, mininterval=0)
 
 
 def tick(bar: Any, n_faces: int) -> None:
