@@ -133,9 +133,7 @@ class TaggedMesh:
         elif self.vertex_uv is not None:
             visual = trimesh.visual.TextureVisuals(uv=self.vertex_uv, material=_material(self))
         elif self.uv is not None and self.face_uv is not None:  # UV seams: one vertex per (vertex, UV) pair
-            from .weld import classes
-
-            corner, first = classes([F.ravel(), self.face_uv.ravel()], F.size)
+            corner, first = _pair_classes(F.ravel(), self.face_uv.ravel())
             copy_of = np.full(len(V), -1, np.int64)
             copy_of[F.ravel()[first][::-1]] = np.arange(len(first))[::-1]  # first copy of each vertex
             tags["sharp_edges"] = copy_of[tags["sharp_edges"]]
@@ -172,6 +170,21 @@ class TaggedMesh:
             if np.size(a):  # pyvista refuses empty arrays: an absent tag means none
                 poly.field_data[k] = a
         return poly
+
+
+def _pair_classes(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Classes of equal (a, b) pairs numbered by first appearance: (class of each pair, first
+    pair of each class).
+
+    >>> [x.tolist() for x in _pair_classes(np.array([5, 1, 5]), np.array([0, 2, 0]))]
+    [[0, 1, 0], [0, 1]]
+    """
+    keys = a.astype(np.int64) * (int(b.max(initial=0)) + 1) + b
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return rank[inverse.ravel()], first[order]
 
 
 def _material(m: TaggedMesh):
