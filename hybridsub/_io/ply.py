@@ -148,7 +148,7 @@ def _empty(el: _Element) -> None:
 
 def _read_ply_ascii(path: str) -> tuple[dict[str, dict[str, Any]], list[str]]:
     """:func:`read_ply` for an ASCII file: whole tables parsed by NumPy, where plyfile parses
-    value by value (22 s instead of 8 s for 377k faces)."""
+    value by value (25 s instead of 6.8 s for 350k faces)."""
     with open(path, "rb") as fh:
         raw = fh.read()
     fmt, elements, pos, comments = _parse_header(raw, path)
