@@ -143,9 +143,10 @@ def test_write_mesh_of_a_trimesh_result_and_to_trimesh(tmp_path, tagged):
         write_mesh(tmp_path / "x.obj", V)
 
 
-def test_pyvista_in_and_out(tmp_path, tagged):
+def test_pyvista_in_and_out(tmp_path):
     pv = pytest.importorskip("pyvista")
-    V, F, E, s, C, S = tagged
+    m = read_mesh(os.path.join(DATA, "cube-meshed.off"))
+    V, F = m.vertices, m.faces
     poly = pv.PolyData.from_regular_faces(V, F)
     poly.point_data["height"] = V[:, 2]
     poly.point_data["label"] = np.arange(len(V), dtype=np.int32) % 7
