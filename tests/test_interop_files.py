@@ -13,6 +13,8 @@ from hybridsub import MeshError, read_mesh, write_mesh
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TET = (np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]]),
+       np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]))
 
 
 @pytest.fixture(scope="module")
@@ -107,8 +109,7 @@ def test_meshio_volume_and_cli(tmp_path):
     with pytest.raises(MeshError, match="tetra cells, a volume mesh"):
         read_mesh(tmp_path / "tet.vtu")
     src = tmp_path / "in.vtk"
-    V, F = hybridsub.load_example("tetrahedron") if False else (np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]]),
-                                                                 np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]))
+    V, F = TET
     write_mesh(src, V, F, sharp_edges=[[0, 1]])
     from hybridsub._app.cli import main
 
@@ -225,15 +226,20 @@ def test_textured_obj_elsewhere_and_glb_keep_the_texture(tmp_path):
     assert main(["subdivide", src, "-o", str(tmp_path / "out" / "fine.glb"), "--levels", "1", "-q"]) == 0
     g = trimesh.load(tmp_path / "out" / "fine.glb", force="mesh")
     assert g.visual.material.baseColorTexture.size == (8, 8)
+    # written under a temporary name elsewhere, then moved (as batch does): named for where it goes
+    from hybridsub import _io
+
+    tmp, final = tmp_path / "tmp" / "x.obj", tmp_path / "final" / "x.obj"
+    _io.write(str(tmp), read_mesh(src), folder=str(final.parent))
+    assert "mtllib m.mtl" in tmp.read_text() and not (tmp_path / "tmp" / "m.mtl").exists()
+    assert (final.parent / "maps" / "t.png").exists()
 
 
 # ------------------------------------------------------------------------------ progress
 
 
 def test_progress_option_draws_a_tqdm_bar(capsys):
-    V, F = hybridsub.load_example("tetrahedron") if False else (np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1],
-                                                                          [-1, -1, 1]]),
-                                                                np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]))
+    V, F = TET
     V2, F2 = hybridsub.subdivide(V, F, levels=3, progress=True)
     err = capsys.readouterr().err
     assert "3/3" in err and f"{len(F2):,} faces" in err

@@ -349,7 +349,7 @@ def subdivide_file(opts: FileOptions, src: str, dst: str, write_to: str | None =
         out = replace(out, sharp_edges=np.empty((0, 2), np.int64), sharpness=np.empty(0),
                       corners=np.empty(0, np.int64), sharp_faces=np.empty(0, np.int64))
     t = time.perf_counter()
-    dropped = _io.write(write_to or dst, out, binary=not opts.ascii)
+    dropped = _io.write(write_to or dst, out, binary=not opts.ascii, folder=os.path.dirname(os.path.abspath(dst)))
     dt = time.perf_counter() - t
     kept = _io.describe_tags(out)
     if dropped:

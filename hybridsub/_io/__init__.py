@@ -20,5 +20,6 @@ from .off import read_off
 from .tagfiles import read_edge_file, read_list_file
 from .weld import classes, weld
 
-__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "classes", "kind_of", "triangles_of", "describe_tags", "example_path", "load_example", "read_edge_file",
+__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "classes", "kind_of", "triangles_of",
+           "describe_tags", "example_path", "load_example", "read_edge_file",
            "read_list_file", "read_mesh", "read_off", "weld", "write", "write_mesh"]

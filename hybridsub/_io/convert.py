@@ -45,7 +45,8 @@ def from_trimesh(mesh) -> TaggedMesh:
     kind = getattr(mesh.visual, "kind", None)
     if kind == "vertex":
         colors = np.asarray(mesh.visual.vertex_colors)
-    elif kind == "texture" and getattr(mesh.visual, "uv", None) is not None and len(mesh.visual.uv) == len(mesh.vertices):
+    elif kind == "texture" and getattr(mesh.visual, "uv", None) is not None \
+            and len(mesh.visual.uv) == len(mesh.vertices):
         uv = np.asarray(mesh.visual.uv, dtype=np.float64)
     return as_tagged(np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64).reshape(-1, 3),
                      vertex_colors=colors, uv=uv, **tags)

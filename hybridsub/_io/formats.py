@@ -1,10 +1,12 @@
 """Mesh files with their features: read and written by extension. OBJ with OpenSubdiv's tags,
-PLY with tag elements, OFF and NumPy's NPZ (one array per attribute) have a module each here;
-every other format trimesh reads and writes goes through :mod:`.trimesh_formats`.
+PLY with tags in header comments, OFF and NumPy's NPZ (one array per attribute) have a module
+each here; meshio's formats (VTK, VTU, XDMF, …; not STL) go through :mod:`.meshio_formats`,
+every other format trimesh reads and writes through :mod:`.trimesh_formats`. ``write_mesh``
+also takes a trimesh or pyvista mesh (:mod:`.convert`).
 
 OBJ, PLY and OFF are read and written vertex for vertex in file order, because crease and
 corner tags name vertices by index: a reader that merges or reorders vertices would move the
-tags onto the wrong vertices. Other formats (STL, GLB/glTF, 3MF, DAE, …) cannot hold tags. The
+tags onto the wrong vertices. trimesh's formats (STL, GLB/glTF, 3MF, DAE, …) cannot hold tags. The
 tag conventions are in ``docs/formats.md``.
 """
 
@@ -93,19 +95,21 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
 
 
 
-def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayLike | None = None, *, sharp_edges: ArrayLike | None = None,
-               sharpness: ArrayLike | None = None, corners: ArrayLike | None = None,
-               sharp_faces: ArrayLike | None = None, vertex_colors: ArrayLike | None = None,
-               uv: ArrayLike | None = None, face_uv: ArrayLike | None = None, binary: bool = True) -> None:
+def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayLike | None = None, *,
+               sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
+               corners: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+               vertex_colors: ArrayLike | None = None, uv: ArrayLike | None = None,
+               face_uv: ArrayLike | None = None, binary: bool = True) -> None:
     """Write a triangle mesh with its feature tags: arrays, or a mesh object in one line.
 
     OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
     ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``crease`` (vertex1, vertex2,
-    sharpness), ``corner`` and ``sharp_face`` elements; NPZ one array per attribute (the names
-    of :class:`TaggedMesh`'s, ``inf`` for infinitely sharp); OFF and every other format trimesh writes
-    (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were dropped.
-    Formats trimesh does not write go through meshio (VTK, VTU, XDMF, …: creases as ``line``
-    cells and corners as ``vertex`` cells with cell data ``sharpness``, see docs/formats.md).
+    sharpness), ``corner`` and ``sharp_face`` header comments (which every PLY reader skips);
+    NPZ one array per attribute (the names of :class:`TaggedMesh`'s, ``inf`` for infinitely
+    sharp); meshio's formats (VTK, VTU, XDMF, …) creases as ``line`` cells and corners as
+    ``vertex`` cells with cell data ``sharpness`` (see docs/formats.md); OFF and the formats
+    trimesh writes (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were
+    dropped.
 
     ``write_mesh(path, mesh)`` writes a ``trimesh.Trimesh`` (its tags from
     ``metadata["hybridsub"]``, as :func:`hybridsub.subdivide_mesh` leaves them), a
@@ -179,9 +183,11 @@ def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vert
                    sharp_faces=checked.sharp_faces)
 
 
-def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
+def write(path: str, mesh: TaggedMesh, *, binary: bool = True, folder: str | None = None) -> str:
     """Write ``mesh`` (the format by the extension of ``path``, missing folders created); returns
-    a description of the tags the format could not hold ('' if none).
+    a description of the tags the format could not hold ('' if none). ``folder``: where the
+    file will live, if it is written under a temporary name elsewhere (an OBJ names and copies
+    its material library and textures there).
 
     Examples
     --------
@@ -195,7 +201,7 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     os.makedirs(d, exist_ok=True)
     ext = os.path.splitext(path)[1].lower()
     if ext == ".obj":
-        write_obj(path, mesh)
+        write_obj(path, mesh, folder)
         return ""
     if ext == ".ply":
         write_ply_mesh(path, mesh, binary)

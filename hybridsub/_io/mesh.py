@@ -200,7 +200,8 @@ def _material(m: TaggedMesh):
             continue
         for name in list(m.materials) + list(mats):
             if name in mats:
-                kw = {k: v for k, v in mats[name].items() if k in ("image", "diffuse", "ambient", "specular", "glossiness")}
+                keep = ("image", "diffuse", "ambient", "specular", "glossiness")
+                kw = {k: v for k, v in mats[name].items() if k in keep}
                 return trimesh.visual.material.SimpleMaterial(name=name, **kw)
     return None
 

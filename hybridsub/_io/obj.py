@@ -370,9 +370,11 @@ def boundary_corner_vertices(F: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # writing
 
-def write_obj(path: str, m: TaggedMesh) -> None:
+def write_obj(path: str, m: TaggedMesh, folder: str | None = None) -> None:
     """Write ``m`` as OBJ: OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``,
-    0-based, ``s = 10`` for infinitely sharp), ``t sharpface``, colours, UVs and materials.
+    0-based, ``s = 10`` for infinitely sharp), ``t sharpface``, colours, UVs and materials
+    (named from, and copied into, ``folder``: the folder the file will live in, by default
+    that of ``path``; a file written under a temporary name elsewhere and moved passes it).
 
     Examples
     --------
@@ -389,7 +391,7 @@ def write_obj(path: str, m: TaggedMesh) -> None:
         parts += text_rows("v ", np.hstack([m.vertices, m.vertex_colors[:, :3]]), "%r")
     else:
         parts += text_rows("v ", m.vertices, "%r")
-    folder = os.path.dirname(os.path.abspath(path))
+    folder = os.path.abspath(folder) if folder is not None else os.path.dirname(os.path.abspath(path))
     parts += [f"mtllib {name}\n" for name in _material_libs_for(m.material_libs, folder)]
     if m.uv is not None and m.face_uv is not None:
         parts += text_rows("vt ", m.uv, "%r")

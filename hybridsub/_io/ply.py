@@ -355,7 +355,8 @@ def _comment_tags(path: str, comments: list[str]) -> dict[str, np.ndarray]:
         try:
             A = np.array(" ".join(lines).split(), dtype=np.float64)
         except ValueError as e:
-            raise MeshError(f"{path}: a 'comment {name}' header line holds a value that is not a number ({e})") from None
+            raise MeshError(f"{path}: a 'comment {name}' header line holds a value that is not a number "
+                            f"({e})") from None
         if A.size % _TAG_WIDTH[name]:
             raise MeshError(f"{path}: the 'comment {name}' header lines hold {A.size} numbers, not a multiple of "
                             f"{_TAG_WIDTH[name]} ({name}: " + ", ".join(_TAG_FIELDS[name]) + ")")
