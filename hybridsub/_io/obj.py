@@ -442,6 +442,7 @@ def _material_libs_for(libs: tuple, folder: str) -> list[str]:
         if not _free_or_same(lib, target):
             out.append(_relative(lib, folder))
             continue
+        os.makedirs(folder, exist_ok=True)
         shutil.copyfile(lib, target)
         for ref in _mtl_images(lib):
             src = os.path.normpath(os.path.join(os.path.dirname(lib), ref))
