@@ -88,7 +88,6 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
         With a welded mesh: how UVs (and per-corner data) are refined, as in
         :func:`hybridsub.subdivide_face_varying`. ``"linear"`` (default) never distorts the
         texture.
-
     progress : bool or None
         Show a progress bar (tqdm: a line on a terminal, a widget in a notebook) per level;
         None: only where stderr is a terminal.
