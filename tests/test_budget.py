@@ -251,3 +251,44 @@ def test_command_line_reports_the_limit_and_force_lifts_it(monkeypatch, tmp_path
     err = capsys.readouterr().err
     assert "set by HYBRIDSUB_MAX_MEMORY" in err and "--force" in err
     assert _cli.main(["subdivide", str(src), "-o", str(tmp_path / "a.obj"), "--levels", "2", "-q", "--force"]) == 0
+
+
+# ----------------------------------------------------------------------------------------------
+# cgroup memory limits (containers, Slurm)
+
+
+def _cgroup_tree(tmp_path, monkeypatch, proc: str, files: dict) -> None:
+    root = tmp_path / "cgroup"
+    for rel, text in files.items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(text)
+    (tmp_path / "proc").write_text(proc)
+    monkeypatch.setattr(_budget, "CGROUP_ROOT", str(root))
+    monkeypatch.setattr(_budget, "PROC_CGROUP", str(tmp_path / "proc"))
+
+
+def test_cgroup_v2_limit_of_the_process_and_its_ancestors(tmp_path, monkeypatch):
+    _cgroup_tree(tmp_path, monkeypatch, "0::/slurm/job_7/step_0\n",
+                 {"slurm/job_7/step_0/memory.max": "max\n", "slurm/job_7/memory.max": "1073741824\n",
+                  "slurm/memory.max": "4294967296\n"})
+    assert _budget.cgroup_memory_limit() == 2**30  # the job's limit, below the step's "max"
+    assert _budget.physical_memory() == 2**30
+    n, words = _budget.memory_source()
+    assert n == 2**30 and "cgroup memory limit" in words
+    assert hybridsub.get_memory_limit() == pytest.approx(0.8 * 2**30)
+    with pytest.raises(OutputTooLargeError, match=r"80 % of the 1.1 GB cgroup memory limit"):
+        hybridsub.refine(ms.icosahedron()[1], levels=9, scheme="loop")
+
+
+def test_cgroup_v1_and_none(tmp_path, monkeypatch):
+    # v1 inside a container: the named path is not mounted, the mount root holds the limit
+    _cgroup_tree(tmp_path, monkeypatch, "12:cpu,cpuacct:/docker/abc\n4:memory:/docker/abc\n",
+                 {"memory/memory.limit_in_bytes": "536870912\n"})
+    assert _budget.cgroup_memory_limit() == 512 * 2**20
+    # v1 "unlimited" (2^63 rounded down to a page) and v2 "max": no limit, the RAM counts
+    _cgroup_tree(tmp_path, monkeypatch, "4:memory:/\n0::/\n",
+                 {"memory/memory.limit_in_bytes": "9223372036854771712\n", "memory.max": "max\n"})
+    assert _budget.cgroup_memory_limit() is None
+    assert "of RAM" in _budget.memory_source()[1]
+    monkeypatch.setattr(_budget, "PROC_CGROUP", str(tmp_path / "missing"))  # not Linux, no cgroups
+    assert _budget.cgroup_memory_limit() is None and _budget.physical_memory() > 0

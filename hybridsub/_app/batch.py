@@ -332,7 +332,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
     ----------
     inputs : path, glob pattern, or an iterable of them
         Mesh files (any format :func:`read_mesh` reads), folders (walked, for the extensions
-        ``.obj .ply .off .npz .stl .glb .gltf .3mf .dae``) and glob patterns (``**`` allowed).
+        ``.obj .ply .off .npz .stl .glb .gltf .3mf .dae .vtk .vtu``) and glob patterns (``**`` allowed).
     outdir : path
         The output folder. Outputs mirror the inputs' names below their folder or pattern.
     levels, scheme, feature_angle, feature_sharpness, loop_weights, uv_mode

@@ -357,9 +357,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_subdivide(sub) -> None:
     s = sub.add_parser("subdivide", help="subdivide a mesh file, keeping its features",
-                       description="Subdivide a triangle mesh (OBJ, PLY, OFF, STL, GLB, … anything trimesh reads). "
-                                   "Creases and corners stored in OBJ/PLY files are used and written back, "
-                                   "propagated, when the output is OBJ or PLY.")
+                       description="Subdivide a triangle mesh (OBJ, PLY, OFF, STL, GLB, VTK, VTU, … anything trimesh "
+                                   "or meshio reads). Creases and corners stored in the file are used and "
+                                   "written back, propagated, when the output is OBJ, PLY, NPZ or a meshio "
+                                   "format (VTK, VTU, …).")
     s.add_argument("input", metavar="IN")
     s.add_argument("-o", "--output", metavar="OUT", required=True, help="output file; its extension picks the format")
     s.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")

@@ -1,4 +1,4 @@
-"""trimesh in, trimesh out: ``subdivide_mesh``."""
+"""trimesh in, trimesh out (and pyvista in, pyvista out): ``subdivide_mesh``."""
 
 from __future__ import annotations
 
@@ -7,26 +7,25 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from .. import _input as val
-from .._io import classes
+from .._io import METADATA_KEY, classes, kind_of
 from .._errors import MeshError
 from .._input import detect_features, merge_edges
 from .._refiner import Refinement, refine
 from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
 if TYPE_CHECKING:  # pragma: no cover
+    import pyvista
     import trimesh
 
-#: Key of ``Trimesh.metadata`` under which ``subdivide_mesh`` stores the propagated tags.
-METADATA_KEY = "hybridsub"
 
-
-def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "hybrid",
+def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *, scheme: Scheme = "hybrid",
                    sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
                    sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                    feature_angle: float | None = None, loop_weights: LoopWeights = "loop",
                    weld: bool | None = None, uv_mode: UVMode = "linear",
-                   non_manifold: NonManifold = "raise") -> trimesh.Trimesh:
-    """Subdivide a ``trimesh.Trimesh``, carrying its attributes and features along.
+                   non_manifold: NonManifold = "raise", progress: bool | None = False) -> Any:
+    """Subdivide a ``trimesh.Trimesh`` or a ``pyvista.PolyData``, carrying its attributes and
+    features along; the result is of the type given.
 
     Per-vertex data — colours, every array in ``mesh.vertex_attributes`` — is refined by the
     refinement matrix (the same affine combinations as the positions; colours are rounded
@@ -51,9 +50,16 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     ``mesh.metadata["hybridsub"]`` — where the result stores its own propagated tags, so that
     subdividing the result again keeps the same features.
 
+    **pyvista.** A triangle ``PolyData`` is refined the same way: point data as per-vertex
+    data (through the refinement, like positions; the active normals left out), cell data as
+    per-face data (through ``face_parent``), the active texture coordinates as UVs (welded and
+    refined face-varying as above), the tags read from and written to ``field_data`` as
+    ``sharp_edges`` (k, 2), ``sharpness``, ``corners`` and ``sharp_faces`` (the result also
+    holds ``face_parent``). pyvista is optional: ``pip install "hybridsub[pyvista]"``.
+
     Parameters
     ----------
-    mesh : trimesh.Trimesh
+    mesh : trimesh.Trimesh or pyvista.PolyData
         A triangle mesh, consistently oriented, every edge in one or two faces (after welding,
         if welded). Not modified.
     levels : int
@@ -84,10 +90,13 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
         With a welded mesh: how UVs (and per-corner data) are refined, as in
         :func:`hybridsub.subdivide_face_varying`. ``"linear"`` (default) never distorts the
         texture.
+    progress : bool or None
+        Show a progress bar (tqdm: a line on a terminal, a widget in a notebook) per level;
+        None: only where stderr is a terminal.
 
     Returns
     -------
-    trimesh.Trimesh
+    trimesh.Trimesh or pyvista.PolyData
         The refined mesh (``process=False``: vertex order is hybridsub's index layout; welded,
         it is the UV index layout of ``docs/face_varying.md``: the input's vertices first,
         copies with equal position, UV and data merged).
@@ -114,11 +123,22 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
     >>> len(np.unique(fine.vertices, axis=0)), len(fine.vertices), fine.visual.uv.shape
     (146, 228, (228, 2))
     """
+    kind = kind_of(mesh)
+    if kind == "pyvista":
+        from .pyvista_interop import polydata_as_trimesh, trimesh_as_polydata
+
+        uv_name = mesh.point_data.active_texture_coordinates_name
+        fine = subdivide_mesh(polydata_as_trimesh(mesh), levels, scheme=scheme, sharp_edges=sharp_edges,
+                              sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
+                              feature_angle=feature_angle, loop_weights=loop_weights, weld=weld, uv_mode=uv_mode,
+                              non_manifold=non_manifold, progress=progress)
+        return trimesh_as_polydata(fine, uv_name)
+    if kind != "trimesh":
+        raise TypeError(f"mesh must be a trimesh.Trimesh or a pyvista.PolyData, got {type(mesh).__name__} "
+                        "(for a trimesh Scene: trimesh.util.concatenate(scene.dump()) or scene.to_geometry(); for "
+                        "arrays: hybridsub.subdivide(V, F, ...))")
     import trimesh
 
-    if not isinstance(mesh, trimesh.Trimesh):
-        raise TypeError(f"mesh must be a trimesh.Trimesh, got {type(mesh).__name__} "
-                        "(for a Scene: trimesh.util.concatenate(scene.dump()) or scene.to_geometry())")
     V = val.as_vertices(np.array(mesh.vertices, dtype=np.float64))
     F = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
     n = len(V)
@@ -146,7 +166,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh, levels: int = 1, *, scheme: Scheme = "
         r = refine(w.F, edges_w, levels, n_vertices=len(w.V), scheme=scheme, sharpness=sharp_w,
                    sharp_faces=sharp_faces, corners=corners_w, loop_weights=loop_weights,
                    uv_faces=w.FUV if w.face_varying else None, uv_mode=uv_mode,
-                   n_uvs=w.n_corners if w.face_varying else None, non_manifold=non_manifold)
+                   n_uvs=w.n_corners if w.face_varying else None, non_manifold=non_manifold,
+                   progress=progress)
     except MeshError as e:
         if not w.welded:
             raise

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 MANIFEST = "hybridsub-manifest.jsonl"
 TMPDIR = ".hybridsub-tmp"
 #: Extensions a directory or a pattern picks up (files named one by one may have any).
-MESH_EXTENSIONS = (".obj", ".ply", ".off", ".npz", ".stl", ".glb", ".gltf", ".3mf", ".dae")
+MESH_EXTENSIONS = (".obj", ".ply", ".off", ".npz", ".stl", ".glb", ".gltf", ".3mf", ".dae", ".vtk", ".vtu")
 _MAGIC = re.compile(r"[*?[]")
 
 

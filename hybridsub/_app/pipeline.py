@@ -21,7 +21,7 @@ from .. import _io
 from .._errors import MeshError, OutputTooLargeError
 from .._input import count_of, detect_features, merge_edges
 from .._io import TaggedMesh
-from .._refiner import physical_memory, predict_levels, seam_edges
+from .._refiner import cgroup_memory_limit, physical_memory, predict_levels, seam_edges
 from .._rules import normalize_sharpness
 from .._topology import edge_keys, undirected_edges
 from .._units import rate, short_bytes
@@ -274,13 +274,16 @@ def _check_edges(e, pairs, n, source, path) -> None:
 
 
 def check_memory(opts: FileOptions, pred: list[dict], what: str) -> None:
-    """Refuse a run whose estimated peak exceeds 80% of the memory at hand: the machine's RAM, or
+    """Refuse a run whose estimated peak exceeds 80% of the memory at hand: the machine's RAM or a
+    smaller cgroup limit, or
     ``opts.memory_limit`` (bytes) where the caller has less (a batch task: its Dask worker's
     limit). ``opts.force`` skips the check."""
     if not pred:
         return
     peak = max(p["peak_bytes"] for p in pred)
-    ram, owner = physical_memory(), "this machine has"
+    ram = physical_memory()
+    owner = "this process's cgroup (container, Slurm job) allows" if ram and ram == cgroup_memory_limit() \
+        else "this machine has"
     limit = opts.memory_limit
     if limit and (not ram or limit < ram):
         ram, owner = limit, "the Dask worker's memory limit is"
@@ -343,7 +346,7 @@ def subdivide_file(opts: FileOptions, src: str, dst: str, write_to: str | None =
         out = replace(out, sharp_edges=np.empty((0, 2), np.int64), sharpness=np.empty(0),
                       corners=np.empty(0, np.int64), sharp_faces=np.empty(0, np.int64))
     t = time.perf_counter()
-    dropped = _io.write(write_to or dst, out, binary=not opts.ascii)
+    dropped = _io.write(write_to or dst, out, binary=not opts.ascii, folder=os.path.dirname(os.path.abspath(dst)))
     dt = time.perf_counter() - t
     kept = _io.describe_tags(out)
     if dropped:

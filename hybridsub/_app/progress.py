@@ -83,28 +83,33 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
 
 
 class _StatusLine:
-    """One line on a stream (stderr), redrawn in place: a label, a bar, a percentage and text."""
+    """One tqdm line on a stream (stderr), redrawn in place: a label, a bar, a percentage and
+    text. tqdm sizes it to the terminal; it is imported only when the line is enabled."""
+
+    _STEPS = 1000  # the bar's resolution
 
     def __init__(self, label: str, enabled: bool, stream=None):
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = enabled
         self.label = label
-        self.shown = False
+        self.bar = None
 
     def draw(self, frac: float, info: str) -> None:
-        width = shutil.get_terminal_size((80, 20)).columns
-        bar_w = 20 if width >= 100 else 10
-        full = int(round(frac * bar_w))
-        line = f"{self.label} [{'#' * full}{'.' * (bar_w - full)}] {frac * 100:3.0f}%  {info}"
-        self.stream.write("\r" + line[:width - 1].ljust(width - 1))
-        self.stream.flush()
-        self.shown = True
+        if self.bar is None:
+            from tqdm import tqdm
+
+            label = self.label.replace("{", "{{").replace("}", "}}")
+            self.bar = tqdm(total=self._STEPS, file=self.stream, leave=True, mininterval=0,
+                            ncols=shutil.get_terminal_size((80, 20)).columns - 1, nrows=20,
+                            bar_format=label + " [{bar:20}] {percentage:3.0f}%  {desc}", ascii=" #")
+        self.bar.n = int(round(min(max(frac, 0.0), 1.0) * self._STEPS))
+        self.bar.set_description_str(info, refresh=False)
+        self.bar.refresh()
 
     def close(self) -> None:
-        if self.enabled and self.shown:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.shown = False
+        if self.enabled and self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 class ProgressBar(_StatusLine):

@@ -1,10 +1,12 @@
 """Mesh files with their features: read and written by extension. OBJ with OpenSubdiv's tags,
-PLY with tag elements, OFF and NumPy's NPZ (one array per attribute) have a module each here;
-every other format trimesh reads and writes goes through :mod:`.trimesh_formats`.
+PLY with tags in header comments, OFF and NumPy's NPZ (one array per attribute) have a module
+each here; meshio's formats (VTK, VTU, XDMF, …; not STL) go through :mod:`.meshio_formats`,
+every other format trimesh reads and writes through :mod:`.trimesh_formats`. ``write_mesh``
+also takes a trimesh or pyvista mesh (:mod:`.convert`).
 
 OBJ, PLY and OFF are read and written vertex for vertex in file order, because crease and
 corner tags name vertices by index: a reader that merges or reorders vertices would move the
-tags onto the wrong vertices. Other formats (STL, GLB/glTF, 3MF, DAE, …) cannot hold tags. The
+tags onto the wrong vertices. trimesh's formats (STL, GLB/glTF, 3MF, DAE, …) cannot hold tags. The
 tag conventions are in ``docs/formats.md``.
 """
 
@@ -14,6 +16,8 @@ import contextlib
 import os
 import uuid
 import warnings
+from dataclasses import replace
+from typing import Any
 
 from numpy.typing import ArrayLike
 
@@ -23,6 +27,8 @@ from .npz import read_npz, write_npz
 from .obj import read_obj, write_obj
 from .off import read_off_mesh, write_off
 from .ply import read_ply_mesh, write_ply_mesh
+from .convert import from_pyvista, from_trimesh, kind_of
+from .meshio_formats import meshio_knows, read_meshio, write_meshio
 from .trimesh_formats import read_trimesh, write_trimesh
 
 
@@ -81,30 +87,42 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
         mesh = read_off_mesh(path, triangulate)
     elif ext == ".npz":
         mesh = read_npz(path)
+    elif _through_meshio(path):
+        mesh = read_meshio(path, triangulate)
     else:
         mesh = read_trimesh(path, ext)
     return check_read(path, mesh)
 
 
 
-def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *, sharp_edges: ArrayLike | None = None,
-               sharpness: ArrayLike | None = None, corners: ArrayLike | None = None,
-               sharp_faces: ArrayLike | None = None, vertex_colors: ArrayLike | None = None,
-               uv: ArrayLike | None = None, face_uv: ArrayLike | None = None, binary: bool = True) -> None:
-    """Write a triangle mesh with its feature tags.
+def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayLike | None = None, *,
+               sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
+               corners: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+               vertex_colors: ArrayLike | None = None, uv: ArrayLike | None = None,
+               face_uv: ArrayLike | None = None, binary: bool = True) -> None:
+    """Write a triangle mesh with its feature tags: arrays, or a mesh object in one line.
 
     OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
     ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``crease`` (vertex1, vertex2,
-    sharpness), ``corner`` and ``sharp_face`` elements; NPZ one array per attribute (the names
-    of :class:`TaggedMesh`'s, ``inf`` for infinitely sharp); OFF and every other format trimesh writes
-    (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were dropped.
+    sharpness), ``corner`` and ``sharp_face`` header comments (which every PLY reader skips);
+    NPZ one array per attribute (the names of :class:`TaggedMesh`'s, ``inf`` for infinitely
+    sharp); meshio's formats (VTK, VTU, XDMF, …) creases as ``line`` cells and corners as
+    ``vertex`` cells with cell data ``sharpness`` (see docs/formats.md); OFF and the formats
+    trimesh writes (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were
+    dropped.
+
+    ``write_mesh(path, mesh)`` writes a ``trimesh.Trimesh`` (its tags from
+    ``metadata["hybridsub"]``, as :func:`hybridsub.subdivide_mesh` leaves them), a
+    ``pyvista.PolyData`` (tags from ``field_data``) or a :class:`TaggedMesh`, with its colours
+    or UVs; tag arguments given as well replace the stored ones.
 
     Parameters
     ----------
     path : str or path-like
         The file; its extension chooses the format. Missing folders are created.
-    vertices : (n, 3) array_like of float
+    vertices : (n, 3) array_like of float, or trimesh.Trimesh, pyvista.PolyData or TaggedMesh
     faces : (m, 3) array_like of int
+        Required with vertex arrays; not with a mesh object.
     sharp_edges : (k, 2) array_like of int, optional
     sharpness : (k,) array_like of float, optional
         Default ``inf``; written as 10 (OpenSubdiv's infinitely sharp).
@@ -120,15 +138,19 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *
 
     Examples
     --------
-    >>> import hybridsub, tempfile, os
+    >>> import hybridsub, tempfile, os, trimesh
     >>> V, F = hybridsub.load_example()
     >>> feat = hybridsub.detect_features(V, F, angle=30)
     >>> path = os.path.join(tempfile.mkdtemp(), "fandisk.obj")
     >>> hybridsub.write_mesh(path, V, F, sharp_edges=feat.sharp_edges, corners=feat.corners)
     >>> len(hybridsub.read_mesh(path).sharp_edges)
     722
+    >>> fine = hybridsub.subdivide_mesh(trimesh.Trimesh(V, F, process=False), feature_angle=30)
+    >>> hybridsub.write_mesh(path, fine)                  # a result with its tags, in one line
+    >>> len(hybridsub.read_mesh(path).sharp_edges)
+    1444
     """
-    mesh = as_tagged(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv)
+    mesh = _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv)
     dropped = write(os.fspath(path), mesh, binary=binary)
     if dropped:
         warnings.warn(f"{os.fspath(path)}: this format cannot hold {dropped}; write .obj or .ply to keep them",
@@ -136,9 +158,36 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike, faces: ArrayLike, *
 
 
 
-def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
+def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv) -> TaggedMesh:
+    """write_mesh's arguments as a TaggedMesh: arrays, or a mesh object and optional tags."""
+    kind = "tagged" if isinstance(vertices, TaggedMesh) else kind_of(vertices)
+    if kind is None:
+        if faces is None:
+            raise TypeError("write_mesh(path, vertices, faces, ...) needs faces, or write_mesh(path, mesh) a "
+                            f"trimesh.Trimesh, pyvista.PolyData or hybridsub.TaggedMesh; got {type(vertices).__name__}")
+        return as_tagged(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv)
+    if faces is not None:
+        raise TypeError(f"write_mesh(path, mesh) takes no faces: the {type(vertices).__name__} has its own")
+    if vertex_colors is not None or uv is not None or face_uv is not None:
+        raise TypeError("write_mesh(path, mesh): colours and UVs come from the mesh; pass arrays to set them")
+    m = vertices if kind == "tagged" else from_trimesh(vertices) if kind == "trimesh" else from_pyvista(vertices)
+    if sharp_edges is None and sharpness is None and corners is None and sharp_faces is None:
+        return m
+    tags = m.tag_arrays()
+    if sharp_edges is not None or sharpness is not None:
+        tags["sharp_edges"], tags["sharpness"] = sharp_edges, sharpness
+    tags["corners"] = tags["corners"] if corners is None else corners
+    tags["sharp_faces"] = tags["sharp_faces"] if sharp_faces is None else sharp_faces
+    checked = as_tagged(m.vertices, m.faces, **tags)
+    return replace(m, sharp_edges=checked.sharp_edges, sharpness=checked.sharpness, corners=checked.corners,
+                   sharp_faces=checked.sharp_faces)
+
+
+def write(path: str, mesh: TaggedMesh, *, binary: bool = True, folder: str | None = None) -> str:
     """Write ``mesh`` (the format by the extension of ``path``, missing folders created); returns
-    a description of the tags the format could not hold ('' if none).
+    a description of the tags the format could not hold ('' if none). ``folder``: where the
+    file will live, if it is written under a temporary name elsewhere (an OBJ names and copies
+    its material library and textures there).
 
     The file is written under a temporary name in the same folder and renamed onto ``path``
     when complete, so a failed write (a full disk, a file-size limit, an unknown format) leaves
@@ -158,9 +207,10 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     os.makedirs(d, exist_ok=True)
     ext = os.path.splitext(path)[1].lower()
     # a fresh name beside the destination (same folder: the rename is atomic, relative links hold)
-    tmp = os.path.join(d, f".{os.path.basename(path)}.{uuid.uuid4().hex[:12]}.partial{ext}")
+    # (the whole name kept at the end, so that double extensions such as .vol.gz still choose the format)
+    tmp = os.path.join(d, f".partial.{uuid.uuid4().hex[:12]}.{os.path.basename(path)}")
     try:
-        dropped = _write_format(tmp, mesh, ext, binary)
+        dropped = _write_format(tmp, mesh, ext, binary, d if folder is None else folder)
         os.replace(tmp, path)
     except BaseException as e:
         with contextlib.suppress(OSError):
@@ -173,10 +223,11 @@ def write(path: str, mesh: TaggedMesh, *, binary: bool = True) -> str:
     return dropped
 
 
-def _write_format(path: str, mesh: TaggedMesh, ext: str, binary: bool) -> str:
-    """Write ``mesh`` to ``path`` as format ``ext``; returns the tags the format cannot hold."""
+def _write_format(path: str, mesh: TaggedMesh, ext: str, binary: bool, folder: str) -> str:
+    """Write ``mesh`` to ``path`` as format ``ext`` (an OBJ's materials named from ``folder``); returns
+    the tags the format cannot hold."""
     if ext == ".obj":
-        write_obj(path, mesh)
+        write_obj(path, mesh, folder)
         return ""
     if ext == ".ply":
         write_ply_mesh(path, mesh, binary)
@@ -186,6 +237,24 @@ def _write_format(path: str, mesh: TaggedMesh, ext: str, binary: bool) -> str:
         return ""
     if ext == ".off":
         write_off(path, mesh)
+    elif _through_meshio(path):
+        return write_meshio(path, mesh)
     else:
         write_trimesh(path, mesh, ext)
     return describe_tags(mesh)
+
+
+def _through_meshio(path: str) -> bool:
+    """Whether hybridsub reads and writes ``path`` through meshio: every format meshio knows
+    but STL, which trimesh reads (and welds) itself. (trimesh hands VTK, VTU, XDMF, … to meshio
+    as well, but with the triangles alone: read directly, the tag cells come along.)"""
+    ext = _meshio_ext(path)
+    return ext != ".stl" and meshio_knows(ext)
+
+
+def _meshio_ext(path: str) -> str:
+    """The extension meshio would choose the format by (``.vol.gz`` is one)."""
+    name = os.path.basename(path).lower()
+    two = "." + ".".join(name.split(".")[-2:]) if name.count(".") >= 2 else ""
+    return two if two.endswith(".gz") else os.path.splitext(name)[1]
+

@@ -13,6 +13,10 @@ from .._errors import MeshError
 from .._input import as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices, count_of, tag_counts
 from .._rules import INFINITE_SHARPNESS
 
+#: Key of ``Trimesh.metadata`` under which hybridsub keeps a mesh's tags (``subdivide_mesh``'s
+#: results, ``TaggedMesh.to_trimesh``; read back by ``subdivide_mesh`` and ``write_mesh``).
+METADATA_KEY = "hybridsub"
+
 #: Sharpness written for infinitely sharp creases and corners (OpenSubdiv's convention:
 #: a sharpness of 10 or more is infinitely sharp).
 INFINITE = INFINITE_SHARPNESS
@@ -103,6 +107,110 @@ class TaggedMesh:
     @property
     def has_tags(self) -> bool:
         return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces))
+
+    def tag_arrays(self) -> dict:
+        """The tags as arrays by name: ``sharp_edges`` (k, 2), ``sharpness`` (k,) (``inf``:
+        infinitely sharp), ``corners``, ``sharp_faces`` — what :meth:`to_trimesh` stores in
+        ``metadata["hybridsub"]`` and :meth:`to_pyvista` in ``field_data``."""
+        return {"sharp_edges": np.asarray(self.sharp_edges, np.int64).reshape(-1, 2),
+                "sharpness": np.asarray(self.sharpness, np.float64),
+                "corners": np.asarray(self.corners, np.int64), "sharp_faces": np.asarray(self.sharp_faces, np.int64)}
+
+    def to_trimesh(self):
+        """This mesh as a ``trimesh.Trimesh`` (``process=False``), its tags in
+        ``metadata["hybridsub"]`` (where :func:`hybridsub.subdivide_mesh` and
+        :func:`hybridsub.write_mesh` look for them), vertex colours or UVs as its visual (a
+        vertex per (vertex, UV) pair where the UVs have seams; the tags then name the first
+        copy of each vertex, and the vertex count differs from ``len(self.vertices)``).
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> m = hybridsub.TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), corners=np.array([2]))
+        >>> t = m.to_trimesh()
+        >>> t.faces.tolist(), t.metadata["hybridsub"]["corners"].tolist()
+        ([[0, 1, 2]], [2])
+        """
+        import trimesh
+
+        visual = None
+        V, F, tags = self.vertices, self.faces, self.tag_arrays()
+        if self.vertex_colors is not None:
+            visual = trimesh.visual.ColorVisuals(vertex_colors=color_bytes(self.vertex_colors))
+        elif self.vertex_uv is not None:
+            visual = trimesh.visual.TextureVisuals(uv=self.vertex_uv, material=_material(self))
+        elif self.uv is not None and self.face_uv is not None:  # UV seams: one vertex per (vertex, UV) pair
+            corner, first = _pair_classes(F.ravel(), self.face_uv.ravel())
+            copy_of = np.full(len(V), -1, np.int64)
+            copy_of[F.ravel()[first][::-1]] = np.arange(len(first))[::-1]  # first copy of each vertex
+            tags["sharp_edges"] = copy_of[tags["sharp_edges"]]
+            tags["corners"] = copy_of[tags["corners"]]
+            V, F = V[F.ravel()[first]], corner.reshape(-1, 3)
+            visual = trimesh.visual.TextureVisuals(uv=self.uv[self.face_uv.ravel()[first]], material=_material(self))
+        return trimesh.Trimesh(V, F, visual=visual, process=False, metadata={METADATA_KEY: tags})
+
+    def to_pyvista(self):
+        """This mesh as a ``pyvista.PolyData`` (pyvista is optional: ``pip install
+        "hybridsub[pyvista]"``): colours as point data ``"colors"`` (8-bit), UVs as the active
+        texture coordinates (a vertex per (vertex, UV) pair where they have seams), the tags
+        in ``field_data`` as ``sharp_edges`` (k, 2), ``sharpness``, ``corners`` and
+        ``sharp_faces`` (see docs/formats.md).
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> m = hybridsub.TaggedMesh(np.eye(3), np.array([[0, 1, 2]]), corners=np.array([2]))
+        >>> p = m.to_pyvista()                                       # doctest: +SKIP
+        >>> p.n_cells, p.field_data["corners"].tolist()              # doctest: +SKIP
+        (1, [2])
+        """
+        import pyvista as pv
+
+        t = self.to_trimesh()
+        poly = pv.PolyData.from_regular_faces(np.asarray(t.vertices, np.float64), np.asarray(t.faces, np.int64))
+        kind = getattr(t.visual, "kind", None)
+        if kind == "vertex":
+            poly.point_data["colors"] = np.asarray(t.visual.vertex_colors, np.uint8)
+        elif kind == "texture" and getattr(t.visual, "uv", None) is not None:
+            poly.active_texture_coordinates = np.asarray(t.visual.uv, np.float64)
+        for k, a in t.metadata[METADATA_KEY].items():
+            if np.size(a):  # pyvista refuses empty arrays: an absent tag means none
+                poly.field_data[k] = a
+        return poly
+
+
+def _pair_classes(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Classes of equal (a, b) pairs numbered by first appearance: (class of each pair, first
+    pair of each class).
+
+    >>> [x.tolist() for x in _pair_classes(np.array([5, 1, 5]), np.array([0, 2, 0]))]
+    [[0, 1, 0], [0, 1]]
+    """
+    keys = a.astype(np.int64) * (int(b.max(initial=0)) + 1) + b
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return rank[inverse.ravel()], first[order]
+
+
+def _material(m: TaggedMesh):
+    """The first material of ``m``'s OBJ material libraries as a trimesh material (its
+    texture image loaded), or None: what lets GLB output embed the texture."""
+    import trimesh
+
+    for lib in m.material_libs:
+        try:
+            with open(lib, "rb") as fh:
+                mats = trimesh.exchange.obj.parse_mtl(fh.read(), resolver=trimesh.resolvers.FilePathResolver(lib))
+        except (OSError, ValueError):
+            continue
+        for name in list(m.materials) + list(mats):
+            if name in mats:
+                keep = ("image", "diffuse", "ambient", "specular", "glossiness")
+                kw = {k: v for k, v in mats[name].items() if k in keep}
+                return trimesh.visual.material.SimpleMaterial(name=name, **kw)
+    return None
 
 
 def check_read(path: str, mesh: TaggedMesh) -> TaggedMesh:

@@ -9,7 +9,9 @@ tabs). The conventions are in ``docs/formats.md``.
 
 from __future__ import annotations
 
+import filecmp
 import os
+import shutil
 
 import numpy as np
 
@@ -379,9 +381,11 @@ def boundary_corner_vertices(F: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # writing
 
-def write_obj(path: str, m: TaggedMesh) -> None:
+def write_obj(path: str, m: TaggedMesh, folder: str | None = None) -> None:
     """Write ``m`` as OBJ: OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``,
-    0-based, ``s = 10`` for infinitely sharp), ``t sharpface``, colours, UVs and materials.
+    0-based, ``s = 10`` for infinitely sharp), ``t sharpface``, colours, UVs and materials
+    (named from, and copied into, ``folder``: the folder the file will live in, by default
+    that of ``path``; a file written under a temporary name elsewhere and moved passes it).
 
     Examples
     --------
@@ -398,8 +402,8 @@ def write_obj(path: str, m: TaggedMesh) -> None:
         parts += text_rows("v ", np.hstack([m.vertices, m.vertex_colors[:, :3]]), "%r")
     else:
         parts += text_rows("v ", m.vertices, "%r")
-    folder = os.path.dirname(os.path.abspath(path))
-    parts += [f"mtllib {_relative(lib, folder)}\n" for lib in m.material_libs]
+    folder = os.path.abspath(folder) if folder is not None else os.path.dirname(os.path.abspath(path))
+    parts += [f"mtllib {name}\n" for name in _material_libs_for(m.material_libs, folder)]
     if m.uv is not None and m.face_uv is not None:
         parts += text_rows("vt ", m.uv, "%r")
         rows, fmt = np.stack([m.faces + 1, m.face_uv + 1], axis=2).reshape(-1, 6), "%d/%d"
@@ -432,6 +436,50 @@ def _tag_lines(m: TaggedMesh) -> list[str]:
         chunk = S[i:i + 16]
         parts.append(f"t sharpface {len(chunk)}/0/0 " + " ".join(map(str, chunk)) + "\n")
     return parts
+
+
+def _material_libs_for(libs: tuple, folder: str) -> list[str]:
+    """The ``mtllib`` names of an OBJ written in ``folder``. A library in another folder is
+    copied beside the file, with the texture images it names by relative path, so that the
+    folder is complete and every loader finds the texture (trimesh, for one, does not follow
+    ``../``); where a different file already has the name, or the library is missing, the
+    line names the library relative to the new file instead."""
+    out = []
+    for lib in libs:
+        if os.path.dirname(lib) == folder or not os.path.isfile(lib):
+            out.append(_relative(lib, folder))
+            continue
+        target = os.path.join(folder, os.path.basename(lib))
+        if not _free_or_same(lib, target):
+            out.append(_relative(lib, folder))
+            continue
+        os.makedirs(folder, exist_ok=True)
+        shutil.copyfile(lib, target)
+        for ref in _mtl_images(lib):
+            src = os.path.normpath(os.path.join(os.path.dirname(lib), ref))
+            dst = os.path.normpath(os.path.join(folder, ref))
+            if os.path.isabs(ref) or not dst.startswith(folder + os.sep) or not os.path.isfile(src):
+                continue
+            if _free_or_same(src, dst):
+                os.makedirs(os.path.dirname(dst), exist_ok=True)
+                shutil.copyfile(src, dst)
+        out.append(os.path.basename(lib))
+    return out
+
+
+def _free_or_same(src: str, dst: str) -> bool:
+    return not os.path.exists(dst) or (os.path.isfile(dst) and filecmp.cmp(src, dst, shallow=False))
+
+
+def _mtl_images(lib: str) -> list[str]:
+    """The files a material library names (``map_Kd``, ``bump``, …: the last word of the line)."""
+    names = []
+    with open(lib, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            w = line.split()
+            if len(w) >= 2 and (w[0].lower().startswith("map_") or w[0].lower() in ("bump", "disp", "decal", "refl")):
+                names.append(w[-1])
+    return names
 
 
 def _relative(path: str, folder: str) -> str:

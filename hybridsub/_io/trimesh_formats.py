@@ -4,13 +4,25 @@ colours and UVs, no tags. trimesh is imported only when such a file is read or w
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
-
 import numpy as np
 
 from .._errors import MeshError
-from .mesh import TaggedMesh, color_bytes
-from .weld import classes, weld
+from .mesh import METADATA_KEY, TaggedMesh
+from .weld import weld
+
+
+def trimesh_reads(ext: str) -> bool:
+    """Whether trimesh reads files of extension ``ext`` (``".stl"``)."""
+    import trimesh
+
+    return ext.lstrip(".") in trimesh.available_formats()
+
+
+def trimesh_writes(ext: str) -> bool:
+    """Whether trimesh writes files of extension ``ext``."""
+    import trimesh
+
+    return ext.lstrip(".") in trimesh.exchange.export._mesh_exporters
 
 
 def read_trimesh(path: str, ext: str) -> TaggedMesh:
@@ -69,26 +81,17 @@ def read_trimesh(path: str, ext: str) -> TaggedMesh:
 
 def write_trimesh(path: str, m: TaggedMesh, ext: str) -> None:
     """Write ``m`` through trimesh as format ``ext``: geometry, vertex colours or UVs (a vertex
-    per (vertex, UV) pair where the UVs have seams); tags are not written."""
+    per (vertex, UV) pair where the UVs have seams) with the texture of ``m``'s OBJ material
+    (GLB embeds its image); tags are not written."""
     import trimesh
 
     kind = ext.lstrip(".")
     if kind not in trimesh.exchange.export._mesh_exporters:
         raise MeshError(f"{path}: trimesh cannot write {ext or '(no extension)'!r} files; known: "
                         + ", ".join(sorted(trimesh.exchange.export._mesh_exporters)))
-    visual: Any = None
-    V, F = m.vertices, m.faces
-    if m.vertex_colors is not None:
-        visual = trimesh.visual.ColorVisuals(vertex_colors=color_bytes(m.vertex_colors))
-    elif m.vertex_uv is not None:
-        visual = trimesh.visual.TextureVisuals(uv=m.vertex_uv)
-    elif m.uv is not None and m.face_uv is not None:  # UV seams: one vertex per (vertex, UV index) pair
-        corner, first = classes([F.ravel(), m.face_uv.ravel()], F.size)
-        V, F = V[F.ravel()[first]], corner.reshape(-1, 3)
-        visual = trimesh.visual.TextureVisuals(uv=m.uv[m.face_uv.ravel()[first]])
-    mesh = trimesh.Trimesh(V, F, visual=visual, process=False)
+    mesh = m.to_trimesh()
+    mesh.metadata.pop(METADATA_KEY, None)  # arrays: not for the file's own metadata
     try:
         mesh.export(path)
     except Exception as e:
         raise MeshError(f"{path}: trimesh could not write it: {type(e).__name__}: {e}") from None
-

@@ -5,7 +5,8 @@ The limit, in bytes, is taken from (first found):
 1. the ``max_memory=`` argument of ``refine`` / ``subdivide``;
 2. :func:`set_memory_limit`;
 3. the environment variable ``HYBRIDSUB_MAX_MEMORY`` (read at every call);
-4. 80 % of the machine's physical memory (8 GiB where that cannot be read) — the threshold
+4. 80 % of the memory this process may use — the machine's physical memory, or a smaller cgroup
+   limit (containers, Slurm jobs) — 8 GiB where neither can be read — the threshold
    the command line's own check uses; the estimate errs high, so this is not a tight fit.
 
 A limit is a number of bytes, or a string such as ``"16G"``, ``"16GB"`` (10⁹), ``"16GiB"``
@@ -78,11 +79,79 @@ def parse_limit(value, source: str = "max_memory") -> float:
 
 
 def physical_memory() -> int | None:
-    """Bytes of physical memory, or None where the platform does not say."""
+    """Bytes of memory this process may use: the machine's physical memory, or less where a
+    cgroup limits it (a container, a Slurm job; see :func:`memory_source`); None where neither
+    can be read."""
+    return memory_source()[0]
+
+
+#: Where the cgroup file systems and this process's cgroup are read (tests point them elsewhere).
+CGROUP_ROOT = "/sys/fs/cgroup"
+PROC_CGROUP = "/proc/self/cgroup"
+
+
+def memory_source() -> tuple[int | None, str]:
+    """(bytes of memory this process may use, what limits it in words).
+
+    The physical memory (``sysconf``), or a smaller cgroup limit: cgroup v2's ``memory.max``
+    of this process's cgroup and its ancestors, cgroup v1's ``memory.limit_in_bytes`` (what
+    Docker, Kubernetes and Slurm's ``--mem`` set). No library reads these, hence this function.
+
+    Examples
+    --------
+    >>> n, words = memory_source()
+    >>> n is None or n > 0
+    True
+    """
+    phys: int | None
     try:
-        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+        phys = int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
     except (AttributeError, ValueError, OSError):  # pragma: no cover - platform dependent
+        phys = None
+    limit = cgroup_memory_limit()
+    if limit is not None and (phys is None or limit < phys):
+        return limit, f"the {fmt_bytes(limit)} cgroup memory limit of this process"
+    if phys is None:  # pragma: no cover - platform dependent
+        return None, "an unknown amount of RAM"
+    return phys, f"this machine's {fmt_bytes(phys)} of RAM"
+
+
+def cgroup_memory_limit() -> int | None:
+    """The smallest cgroup memory limit over this process's cgroup and its ancestors, in bytes
+    (v2 ``memory.max``, v1 ``memory.limit_in_bytes``), or None where there is none (``max``,
+    v1's "unlimited" 2⁶³-page value) or the files cannot be read (no cgroups, not Linux)."""
+    try:
+        with open(PROC_CGROUP, encoding="ascii", errors="replace") as fh:
+            lines = fh.read().splitlines()
+    except OSError:
         return None
+    found: list[int] = []
+    for line in lines:
+        parts = line.split(":", 2)
+        if len(parts) != 3:
+            continue
+        _, controllers, rel = parts
+        if controllers == "":  # cgroup v2: the unified hierarchy
+            found += _limits_up(CGROUP_ROOT, rel, "memory.max")
+        elif "memory" in controllers.split(","):  # cgroup v1: the memory controller's hierarchy
+            found += _limits_up(os.path.join(CGROUP_ROOT, "memory"), rel, "memory.limit_in_bytes")
+    return min(found) if found else None
+
+
+def _limits_up(root: str, rel: str, name: str) -> list[int]:
+    """The limits in file ``name`` of cgroup ``rel`` and its ancestors under ``root`` (inside a
+    container the cgroup's path is often not mounted as named: its mount root counts too)."""
+    parts = [p for p in rel.strip().split("/") if p and p != ".."]
+    out = []
+    for k in range(len(parts), -1, -1):
+        try:
+            with open(os.path.join(root, *parts[:k], name), encoding="ascii") as fh:
+                text = fh.read().strip()
+        except OSError:
+            continue
+        if text.isdigit() and int(text) < 2**62:  # v1 writes "unlimited" as 2^63 rounded to a page
+            out.append(int(text))
+    return out
 
 
 def set_memory_limit(limit: MemoryLimit) -> None:
@@ -93,7 +162,8 @@ def set_memory_limit(limit: MemoryLimit) -> None:
     limit : int, float, str or None
         Bytes (``inf``: no limit), or a string such as ``"16G"`` (10⁹ bytes), ``"16GiB"``
         (2³⁰ bytes) or ``"none"``. ``None`` restores the default: the environment variable
-        ``HYBRIDSUB_MAX_MEMORY`` if set, else 80 % of the physical memory.
+        ``HYBRIDSUB_MAX_MEMORY`` if set, else 80 % of the memory this process may use
+        (the physical memory, or a smaller cgroup limit).
 
     Examples
     --------
@@ -112,7 +182,7 @@ def get_memory_limit(max_memory: MemoryLimit = None) -> float:
 
     ``max_memory`` (a per-call value, as ``refine`` takes it) wins over
     :func:`set_memory_limit`, which wins over ``HYBRIDSUB_MAX_MEMORY``, which wins over the
-    default (80 % of the physical memory).
+    default (80 % of the physical memory, or of a smaller cgroup memory limit).
     """
     limit, _ = _resolve(max_memory)
     return limit
@@ -127,10 +197,10 @@ def _resolve(max_memory) -> tuple[float, str]:
     env = os.environ.get(ENV_VAR)
     if env is not None and env.strip():
         return parse_limit(env, f"the environment variable {ENV_VAR}"), ENV_VAR
-    phys = physical_memory()
+    phys, words = memory_source()
     if phys is None:  # pragma: no cover - platform dependent
         return float(FALLBACK_LIMIT), "the default (8 GiB: the physical memory could not be read)"
-    return DEFAULT_FRACTION * phys, f"the default (80 % of this machine's {fmt_bytes(phys)} of RAM)"
+    return DEFAULT_FRACTION * phys, f"the default (80 % of {words})"
 
 
 # --------------------------------------------------------------------------------------

@@ -38,7 +38,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[False] = ...,
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ...) -> tuple[Positions, Faces]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces]: ...
 
 
 @overload
@@ -46,14 +46,14 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[True],
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
 def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
-              max_memory: MemoryLimit = None,
+              max_memory: MemoryLimit = None, progress: bool | None = False,
               ) -> tuple[Positions, Faces] | tuple[Positions, Faces, sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
@@ -90,6 +90,9 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
         oriented edges instead of raising; see :func:`refine`.
     max_memory : int, float or str, optional
         Memory limit in bytes for this call; see :func:`refine` and ``docs/errors.md``.
+    progress : bool or None
+        Show a progress bar per level (tqdm: a line on stderr, a widget in a notebook); None:
+        only where stderr is a terminal.
 
     Returns
     -------
@@ -121,11 +124,11 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
     if return_matrix or inp.cut is not None:  # a cut mesh's positions come through S_1 @ D
-        r = refinement_of(inp)
+        r = refinement_of(inp, progress)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
     last = None
-    for last in walk_data(inp, Vf, tags=False):
+    for last in walk_data(inp, Vf, tags=False, progress=progress):
         pass
     if last is None:  # no step ran: copies of the input
         return Vf.astype(out_dtype, copy=True), inp.faces.copy()
@@ -147,14 +150,14 @@ class LevelOutput:
     uv_faces: np.ndarray | None = None  # (m_k, 3), aligned with faces
 
 
-def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tags: bool = True
-              ) -> Iterator[LevelOutput]:
+def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tags: bool = True,
+              progress: bool | None = False) -> Iterator[LevelOutput]:
     """Refine ``X (n, d)`` (and with ``inp.uv``, ``UV (t, e)``), both float64, step by step.
 
     Tags and face parents come with each level unless ``tags=False`` (always with UVs).
     """
     budget = Budget(inp.levels, inp.scheme, inp.max_memory, keeps_steps=False)
-    for s in walk(inp, budget, topology_last=tags):
+    for s in walk(inp, budget, topology_last=tags, progress=progress):
         X = apply_step(s.level, s.plan, X)
         if s.uv is not None:
             if inp.uv.mode == "smooth":

@@ -22,6 +22,7 @@ import numpy as np
 from .._input.gate import RefineInput
 from .._rules import refinement as R
 from .._topology import Level, StepPlan, child_level, plan_step
+from .bar import level_bar, tick
 from .budget import Budget
 
 
@@ -46,14 +47,23 @@ class Step(NamedTuple):
     uv: UVStep | None  # with face-varying data
 
 
-def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = True) -> Iterator[Step]:
+def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = True,
+         progress: bool | None = False) -> Iterator[Step]:
     """Run ``inp.levels`` steps; yield a :class:`Step` for each (none without faces).
 
     The next level's twins and tags are built for the last step only if ``topology_last``
     (always with face-varying data). ``budget`` may refuse before the first step allocates.
+    ``progress``: a tqdm bar ticks after each step has been used (see :func:`.bar.level_bar`).
     """
     if inp.levels == 0 or inp.n_faces == 0:
         return
+    with level_bar(inp.levels, progress, inp.scheme) as bar:
+        for s in _steps(inp, budget, topology_last):
+            yield s
+            tick(bar, len(s.faces))
+
+
+def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool) -> Iterator[Step]:
     level, corner = inp.level, inp.corner
     uvl = uv_fixed = None
     if inp.uv is not None:

@@ -183,7 +183,7 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
            scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
            corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
            non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
-           n_uvs: int | None = None, uv_mode: UVMode = "linear") -> Refinement:
+           n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -235,6 +235,9 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     uv_mode : {"linear", "smooth"}
         With ``uv_faces``: ``"linear"`` (default) interpolates UVs linearly, ``"smooth"``
         applies the scheme's rules to the UV index mesh (its boundary and seams as creases).
+    progress : bool or None
+        Show a progress bar per level (tqdm: a line on stderr, a widget in a notebook); None:
+        only where stderr is a terminal.
 
     Returns
     -------
@@ -257,10 +260,10 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode)
-    return refinement_of(inp)
+    return refinement_of(inp, progress)
 
 
-def refinement_of(inp: RefineInput) -> Refinement:
+def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement:
     """The :class:`Refinement` of a checked input: every step's matrix, faces and tags."""
     if inp.n_faces == 0:  # nothing to refine: every level is the input
         return _compose_cut(inp, _unrefined(inp))
@@ -271,7 +274,7 @@ def refinement_of(inp: RefineInput) -> Refinement:
     face_parent = np.arange(inp.n_faces, dtype=np.int64)
     pairs, sharp, mask = inp.sharp_edges, inp.sharpness, inp.faces_out(inp.face_sharp)
     uv_pairs, uv_sharp = np.empty((0, 2), np.int64), np.empty(0)
-    for s in walk(inp, budget):
+    for s in walk(inp, budget, progress=progress):
         parent = face_parents(s.offsets)
         face_parent = face_parent[parent]
         pairs, sharp = child_creases(s.level, s.plan)
