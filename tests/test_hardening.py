@@ -84,7 +84,7 @@ def test_failed_write_leaves_nothing_and_keeps_the_old_file(tmp_path, monkeypatc
     write(str(out), mesh)
     before = out.read_bytes()
 
-    def disk_full(path, m):
+    def disk_full(path, m, folder=None):
         with open(path, "w") as fh:
             fh.write("v 0 0 0\n")  # a partial file, then the disk is full
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), path)
