@@ -215,11 +215,21 @@ def rerun_child(src: str, out: str) -> None:
     before = _rss_kb()
     with open("/proc/self/clear_refs", "w") as fh:
         fh.write("5")  # VmHWM := VmRSS
-    t = time.perf_counter()
+    t, c = time.perf_counter(), os.times()
     s = hybridsub.batch(src, out)
-    sec = time.perf_counter() - t
-    print(json.dumps(dict(n=s.total, skipped=s.skipped, seconds=sec, peak_kb=_rss_peak_kb() - before,
+    sec, c2 = time.perf_counter() - t, os.times()
+    cpu = c2.user + c2.system - c.user - c.system
+    print(json.dumps(dict(n=s.total, skipped=s.skipped, seconds=sec, cpu=cpu, peak_kb=_rss_peak_kb() - before,
                           cluster=s.cluster)))
+
+
+def speed_reference() -> float:
+    """Seconds for 10⁶ turns of an empty Python loop now (about 0.02 s on an idle core): how much
+    the machine's other load slows Python code down at the moment."""
+    t = time.perf_counter()
+    for _ in range(1_000_000):
+        pass
+    return time.perf_counter() - t
 
 
 def rerun_scaling(root: str, sizes: list[int]) -> list[dict]:
@@ -234,13 +244,20 @@ def rerun_scaling(root: str, sizes: list[int]) -> list[dict]:
         r = json.loads(res.stdout.strip().splitlines()[-1])
         assert r["n"] == r["skipped"] == n and not r["cluster"], r
         rows.append(r)
-        print(f"rerun, all done: {n:>9,} inputs  {r['seconds']:7.2f} s  {r['seconds'] / n * 1e6:6.1f} µs/input  "
-              f"peak +{r['peak_kb'] / 1024:6.1f} MiB  {r['peak_kb'] * 1024 / n:7.1f} B/input   "
-              f"(made in {made:.0f} s)", flush=True)
+        print(f"rerun, all done: {n:>9,} inputs  wall {r['seconds']:7.2f} s = {r['seconds'] / n * 1e6:6.1f} µs/input"
+              f"  cpu {r['cpu'] / n * 1e6:6.1f} µs/input  peak +{r['peak_kb'] / 1024:6.1f} MiB = "
+              f"{r['peak_kb'] * 1024 / n:7.1f} B/input   (made in {made:.0f} s; load {os.getloadavg()[0]:.1f}, "
+              f"empty loop {speed_reference():.3f} s)", flush=True)
         shutil.rmtree(d)
     big = rows[-1]
-    print(f"10⁶ inputs, extrapolated from {big['n']:,}: {big['seconds'] / big['n'] * 1e6:.0f} s, "
-          f"{big['peak_kb'] / 1024 / big['n'] * 1e6:.0f} MiB (the per-input figures, times 10⁶)")
+    slope = ""
+    if len(rows) > 1:
+        a = rows[0]
+        per_kb = (big["peak_kb"] - a["peak_kb"]) / (big["n"] - a["n"])
+        slope = f"; memory by its growth from {a['n']:,}: {(a['peak_kb'] + per_kb * (1e6 - a['n'])) / 1024:.0f} MiB"
+    print(f"10⁶ inputs, extrapolated from {big['n']:,} (per-input figures times 10⁶): wall "
+          f"{big['seconds'] / big['n'] * 1e6:.0f} s, cpu {big['cpu'] / big['n'] * 1e6:.0f} s, "
+          f"{big['peak_kb'] / 1024 / big['n'] * 1e6:.0f} MiB{slope}")
     return rows
 
 

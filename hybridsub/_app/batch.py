@@ -19,6 +19,7 @@ import json
 import logging
 import math
 import os
+import sqlite3
 import time
 import uuid
 from collections import deque
@@ -356,7 +357,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
             return _batch(items, len(inputs) > 1, outdir, options, key, dict(
                 force=bool(force), scheduler=scheduler, workers=workers, verify=verify, dry_run=dry_run, lock=lock,
                 fsync=fsync, progress=progress, on_result=on_result), t_start)
-    except (OSError, __import__("sqlite3").Error) as e:
+    except (OSError, sqlite3.Error) as e:
         if is_disk_full(e):
             raise RuntimeError(f"{outdir}: the disk is full ({_strerror(e)}); free some space, then "
                                f"{_RUN_AGAIN}") from None
@@ -565,15 +566,22 @@ _DASK_LOGGERS = ("distributed", "tornado", "asyncio")
 
 @contextlib.contextmanager
 def _quiet_dask():
-    """Dask's loggers at CRITICAL while a batch runs (``distributed.client`` and others have
-    their own level, so each is set), restored after."""
-    names = [n for n in list(logging.root.manager.loggerDict)
-             if n.split(".")[0] in _DASK_LOGGERS] + list(_DASK_LOGGERS)
-    saved = {n: logging.getLogger(n).level for n in names}
-    for n in names:
-        logging.getLogger(n).setLevel(logging.CRITICAL)
+    """Dask's loggers silent while a batch runs, restored after: each existing one disabled
+    (``distributed.client`` and others have their own level, so quieting ``distributed`` is
+    not enough), and the top ones at CRITICAL for those created meanwhile."""
+    loggers = [logging.getLogger(n) for n in list(logging.root.manager.loggerDict)
+               if n.split(".")[0] in _DASK_LOGGERS]
+    tops = [logging.getLogger(n) for n in _DASK_LOGGERS]
+    disabled = [lg.disabled for lg in loggers]
+    levels = [lg.level for lg in tops]
+    for lg in loggers:
+        lg.disabled = True
+    for lg in tops:
+        lg.setLevel(logging.CRITICAL)
     try:
         yield
     finally:
-        for n, level in saved.items():
-            logging.getLogger(n).setLevel(level)
+        for lg, d in zip(loggers, disabled):
+            lg.disabled = d
+        for lg, level in zip(tops, levels):
+            lg.setLevel(level)

@@ -33,7 +33,8 @@ COLUMNS = ("input", "options_key", "status", "reason", "output", "input_size", "
 _JSON = ("notes", "seconds")
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS options (options_key TEXT PRIMARY KEY, options TEXT NOT NULL, hybridsub TEXT NOT NULL);
-CREATE TABLE IF NOT EXISTS names (input TEXT PRIMARY KEY, stem TEXT NOT NULL, stem_cf TEXT NOT NULL UNIQUE);
+CREATE TABLE IF NOT EXISTS names (input TEXT PRIMARY KEY, stem TEXT NOT NULL, stem_cf TEXT NOT NULL UNIQUE)
+    WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS meshes ({", ".join(COLUMNS)}, PRIMARY KEY (input, options_key)) WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS meshes_by_status ON meshes (options_key, status);
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT);
@@ -95,7 +96,7 @@ class Manifest:
     def _connect(self) -> sqlite3.Connection:
         legacy = os.path.join(self.outdir, LEGACY_MANIFEST)
         exists = os.path.exists(self.path)
-        uri = f"file:{quote(self.path)}" + ("" if self.lock else "?vfs=unix-none")
+        uri = f"file:{quote(self.path)}" + ("" if self.lock or self.readonly else "?vfs=unix-none")
         if self.readonly and not exists:
             uri = "file::memory:"
         try:  # a read-only view opens read-write too (never writing), so that closing it removes the WAL files
@@ -160,18 +161,29 @@ class Manifest:
     # ------------------------------------------------------------------------------------------
     # reading, a chunk of inputs at a time
 
-    def lookup(self, inputs: list[str], key: str) -> tuple[dict[str, dict], dict[str, str], set[str]]:
-        """For ``inputs``: their rows under ``key`` (as records), the stems they own, and those
-        with a row under any key."""
+    def lookup(self, inputs: list[str], key: str) -> tuple[dict[str, tuple], dict[str, str], set[str]]:
+        """For ``inputs``: what planning needs of their rows under ``key``, ``input → (status,
+        input_size, input_mtime_ns, output, output_size)``; the stems they own; and, of those
+        without such a row, the ones with a row under another key."""
         marks = ",".join("?" * len(inputs))
-        cur = self.db.execute(f"SELECT {', '.join(COLUMNS)} FROM meshes WHERE options_key = ? AND input IN ({marks})",
-                              [key, *inputs])
-        rows = {r[0]: _record(r) for r in cur}
+        rows = {r[0]: r[1:] for r in self.db.execute(
+            "SELECT input, status, input_size, input_mtime_ns, output, output_size FROM meshes "
+            f"WHERE options_key = ? AND input IN ({marks})", [key, *inputs])}
         stems = dict(self.db.execute(f"SELECT input, stem FROM names WHERE input IN ({marks})", inputs))
         if self._new_stems:
             stems.update((p, self._new_stems[p]) for p in inputs if p in self._new_stems)
-        seen = {r[0] for r in self.db.execute(f"SELECT DISTINCT input FROM meshes WHERE input IN ({marks})", inputs)}
+        seen = set()
+        if len(rows) < len(inputs):
+            rest = [p for p in inputs if p not in rows]
+            seen = {r[0] for r in self.db.execute(
+                f"SELECT DISTINCT input FROM meshes WHERE input IN ({','.join('?' * len(rest))})", rest)}
         return rows, stems, seen
+
+    def record_of(self, path: str, key: str) -> dict | None:
+        """The row of input ``path`` under options ``key``, as a record."""
+        row = self.db.execute(f"SELECT {', '.join(COLUMNS)} FROM meshes WHERE input = ? AND options_key = ?",
+                              (path, key)).fetchone()
+        return _record(row) if row else None
 
     def owner(self, stem: str) -> str | None:
         """The input that owns the output stem (compared without case), if any."""

@@ -52,9 +52,10 @@ def _within(path: str, folder: str) -> bool:
     return os.path.commonpath([path, folder]) == folder
 
 
-def _walk(base: str, real_out: str, keep) -> Iterator[str]:
-    """Files below ``base`` that ``keep(relative parts)`` accepts, a folder's sorted files
-    before its sorted subfolders, the output folder and links to folders not followed."""
+def _walk(base: str, real_out: str, keep) -> Iterator[tuple[str, str]]:
+    """``(path, path relative to base, '/'-separated)`` of the files below ``base`` that
+    ``keep(relative parts)`` accepts, a folder's sorted files before its sorted subfolders, the
+    output folder and links to folders not followed."""
     for root, dirs, names in os.walk(base):
         dirs[:] = sorted(d for d in dirs if not _within(os.path.realpath(os.path.join(root, d)), real_out))
         rel = os.path.relpath(root, base)
@@ -62,9 +63,10 @@ def _walk(base: str, real_out: str, keep) -> Iterator[str]:
         if not keep(prefix, None):
             dirs[:] = []
             continue
+        folder, lead = root + os.sep, "/".join(prefix) + "/" if prefix else ""
         for n in sorted(names):
             if n.lower().endswith(MESH_EXTENSIONS) and keep(prefix, n):
-                yield os.path.join(root, n)
+                yield folder + n, lead + n
 
 
 def _pattern_matcher(parts: list[str]):
@@ -91,8 +93,9 @@ def _pattern_matcher(parts: list[str]):
     return keep
 
 
-def _expand(arg: str, real_out: str) -> tuple[str, Iterator[str]]:
-    """(the base the output names are relative to, the files of one INPUT)."""
+def _expand(arg: str, real_out: str) -> tuple[str, Iterator[tuple[str, str]]]:
+    """(the base the output names are relative to, the files of one INPUT: absolute path, path
+    relative to the base)."""
     if os.path.exists(arg) and _within(os.path.realpath(arg), real_out):
         raise ValueError(f"{arg}: the input lies inside the output folder; write to another folder")
     if _MAGIC.search(arg) and not os.path.exists(arg):
@@ -102,18 +105,19 @@ def _expand(arg: str, real_out: str) -> tuple[str, Iterator[str]]:
         base = fixed if fixed else ("/" if arg.startswith("/") else ".")
         if os.path.isdir(base) and _within(os.path.realpath(base), real_out):
             raise ValueError(f"the pattern {arg!r} looks inside the output folder; write to another folder")
-        files = _walk(base, real_out, _pattern_matcher(parts[i:])) if os.path.isdir(base) else iter(())
+        files = _walk(os.path.abspath(base), real_out, _pattern_matcher(parts[i:])) if os.path.isdir(base) \
+            else iter(())
         return base, _first(files, f"the pattern {arg!r} matches no mesh file ({', '.join(MESH_EXTENSIONS)}; "
                                    "the output folder is not searched)")
     if os.path.isdir(arg):
-        files = _walk(arg, real_out, lambda prefix, name: True)
+        files = _walk(os.path.abspath(arg), real_out, lambda prefix, name: True)
         return arg, _first(files, f"{arg}: the folder holds no mesh file ({', '.join(MESH_EXTENSIONS)})")
     if os.path.exists(arg):
-        return os.path.dirname(arg) or ".", iter([arg])
+        return os.path.dirname(arg) or ".", iter([(os.path.abspath(arg), os.path.basename(arg))])
     raise FileNotFoundError(f"{arg}: no such file or directory")
 
 
-def _first(files: Iterator[str], empty: str) -> Iterator[str]:
+def _first(files: Iterator[tuple[str, str]], empty: str) -> Iterator[tuple[str, str]]:
     """``files`` with its first item fetched now: a folder or pattern without any fails early."""
     first = next(files, None)
     if first is None:
@@ -132,12 +136,9 @@ def walk_inputs(inputs: Iterable[str | os.PathLike], outdir: str) -> Iterator[Ba
     expanded = [_expand(os.fspath(arg), real_out) for arg in inputs]
 
     def items():
-        for base, files in expanded:
-            for f in files:
-                rel = os.path.relpath(f, base).replace(os.sep, "/")
-                if rel.startswith("../") or rel == "..":
-                    rel = os.path.basename(f)
-                yield BatchInput(os.path.abspath(f), os.path.splitext(rel)[0])
+        for _, files in expanded:
+            for path, rel in files:
+                yield BatchInput(path, rel[:len(rel) - len(os.path.splitext(rel)[1])])
 
     return items()
 
@@ -177,19 +178,22 @@ class Planner:
             if it.path not in stems:
                 stems[it.path] = self._free_stem(it, new)
                 new[stems[it.path].casefold()] = it.path
-        self.manifest.take_names((p, stems[p]) for p in new.values())
+        if new:
+            self.manifest.take_names((p, stems[p]) for p in new.values())
         names = [f"{stems[p]}.{self.fmt}" for p in paths]
-        done = [i for i, p in enumerate(paths) if (rows.get(p) or {}).get("status") == "done"]
-        st = self._stat([paths[i] for i in done] + [os.path.join(self.outdir, names[i]) for i in done])
+        done = [i for i, p in enumerate(paths) if p in rows and rows[p][0] == "done"]
+        out_prefix = self.outdir + os.sep
+        st = self._stat([paths[i] for i in done] + [out_prefix + names[i].replace("/", os.sep) for i in done])
         st_in, st_out = dict(zip(done, st[:len(done)])), dict(zip(done, st[len(done):]))
         out = Chunk()
         for i, it in enumerate(batch):
-            prev = rows.get(it.path)
-            skip, reason = decide(prev, names[i], st_in.get(i), st_out.get(i), it.path in seen, self.verify)
+            skip, reason = decide(rows.get(it.path), names[i], st_in.get(i), st_out.get(i), it.path in seen,
+                                  self.verify)
             if skip:
                 out.skipped += 1
             else:
-                out.jobs.append((it, names[i], reason, prev if reason == "verify" else None))
+                prev = self.manifest.record_of(it.path, self.key) if reason == "verify" else None
+                out.jobs.append((it, names[i], reason, prev))
                 out.reasons[reason] += 1
         return out
 
@@ -222,20 +226,22 @@ def _stat_all(paths: list[str]) -> list[tuple[int, int] | None]:
     return out
 
 
-def decide(prev: dict | None, output: str, st_in, st_out, seen_input: bool, verify: bool) -> tuple[bool, str]:
-    """(skip, reason): whether an input is done already (its record ``prev`` under these
-    options, the ``(size, mtime_ns)`` of it and of its output now), and why it runs otherwise."""
+def decide(prev: tuple | None, output: str, st_in, st_out, seen_input: bool, verify: bool) -> tuple[bool, str]:
+    """(skip, reason): whether an input is done already (its row under these options, ``(status,
+    input_size, input_mtime_ns, output, output_size)``, and the ``(size, mtime_ns)`` of it and of
+    its output now), and why it runs otherwise."""
     if prev is None:
         return False, "options changed" if seen_input else "new"
-    if prev.get("status") != "done":
+    status, in_size, in_mtime, prev_output, out_size = prev
+    if status != "done":
         return False, "failed before"
-    if st_in is None or st_in != (prev.get("input_size"), prev.get("input_mtime_ns")):
+    if st_in is None or st_in != (in_size, in_mtime):
         return False, "input changed"
-    if prev.get("output") != output:
+    if prev_output != output:
         return False, "output name changed"
     if st_out is None:
         return False, "output missing"
-    if st_out[0] != prev.get("output_size"):
+    if st_out[0] != out_size:
         return False, "output changed"
     return not verify, "verify"  # skip, or have a worker compare checksums
 
