@@ -18,7 +18,9 @@ extrapolation to 10⁶ inputs.
 ``--overhead N``: N tetrahedra (4 faces, one level: the mesh work is ~nothing) subdivided by a
 batch on a started, warmed cluster of 1 and 2 workers, against the same files subdivided in
 a loop in this process (``pipeline.subdivide_file``): meshes/s, and the per-task overhead,
-(batch wall × workers − loop time) / N, what a task costs beyond its mesh.
+(batch wall × workers − loop time) / N, what a task costs beyond its mesh; the part of it
+inside the task (the records' ``seconds.total`` summed, less the loop); and, for scale, N bare
+Dask tasks (``client.map`` of the identity) on the same cluster.
 
 Collections (written as OBJ into a temporary folder):
 
@@ -287,14 +289,26 @@ def overhead(root: str, n: int, workers: list[int]) -> list[dict]:
         cluster, client = local_cluster(w)
         with cluster, client:
             hybridsub.batch(files[:2 * w], os.path.join(root, f"warm{w}"), scheduler=client, levels=1)
-            s = hybridsub.batch(folder, os.path.join(root, f"out{w}"), scheduler=client, levels=1)
+            recs = []
+            s = hybridsub.batch(folder, os.path.join(root, f"out{w}"), scheduler=client, levels=1,
+                                on_result=recs.append)
+            t = time.perf_counter()
+            client.gather(client.map(_identity, range(n), pure=False))  # Dask's own round trip, nothing else
+            plain = time.perf_counter() - t
         assert s.done == n, s.table()
         per_task = (s.seconds * w - loop) / n
+        in_task = (sum(r["seconds"]["total"] for r in recs) - loop) / n
         rows.append(dict(workers=w, n=n, seconds=s.seconds, rate=n / s.seconds, overhead_ms=per_task * 1e3,
-                         loop_ms=loop / n * 1e3))
+                         loop_ms=loop / n * 1e3, in_task_ms=in_task * 1e3, plain_ms=plain * w / n * 1e3))
         print(f"tetrahedra, 1 level: {w} worker{'s' if w > 1 else ''}  {n} meshes in {s.seconds:.2f} s  "
-              f"{n / s.seconds:6.1f} meshes/s  per-task overhead {per_task * 1e3:.2f} ms", flush=True)
+              f"{n / s.seconds:6.1f} meshes/s  per-task overhead {per_task * 1e3:.2f} ms, of which in the task "
+              f"(checksums, marker, rename) {in_task * 1e3:.2f} ms; a bare Dask task: {plain * w / n * 1e3:.2f} ms  "
+              f"(load {os.getloadavg()[0]:.1f}, empty loop {speed_reference():.3f} s)", flush=True)
     return rows
+
+
+def _identity(x):
+    return x
 
 
 def main(argv=None) -> int:
