@@ -917,7 +917,7 @@ def test_dask_logs_held_back_while_a_batch_runs(capfd):
     client_logger = logging.getLogger("distributed.client")
     before = client_logger.level
     assert before != logging.NOTSET  # Dask's configuration sets it: the reason for the fix
-    with _batch._quiet_dask():
+    with _batch.quiet_dask():
         try:
             raise ConnectionError("scheduler gone")
         except ConnectionError:

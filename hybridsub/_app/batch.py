@@ -353,7 +353,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
         raise ValueError("no inputs given: name mesh files, folders or glob patterns")
     items = walk_inputs(inputs, outdir)
     try:
-        with _quiet_dask():
+        with quiet_dask():
             return _batch(items, len(inputs) > 1, outdir, options, key, dict(
                 force=bool(force), scheduler=scheduler, workers=workers, verify=verify, dry_run=dry_run, lock=lock,
                 fsync=fsync, progress=progress, on_result=on_result), t_start)
@@ -565,7 +565,7 @@ _DASK_LOGGERS = ("distributed", "tornado", "asyncio")
 
 
 @contextlib.contextmanager
-def _quiet_dask():
+def quiet_dask():
     """Dask's loggers silent while a batch runs, restored after: each existing one disabled
     (``distributed.client`` and others have their own level, so quieting ``distributed`` is
     not enough), and the top ones at CRITICAL for those created meanwhile."""
