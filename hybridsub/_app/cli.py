@@ -48,21 +48,29 @@ def cmd_subdivide(a) -> int:
 
 
 def cmd_batch(a) -> int:
-    import logging
-
     from .batch import batch
+    from .manifest import status_report
     from .pipeline import PipelineError
 
-    # Dask logs a lost scheduler as tracebacks; the command says what happened in one line.
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    if a.status is not None and (a.inputs or a.output):
+        a.batch_parser.error("--status OUTDIR takes no INPUT and no -o")  # exits with 2
+    if a.status is None and not (a.inputs and a.output):
+        a.batch_parser.error("give INPUTs and -o OUTDIR (or --status OUTDIR)")
+    if a.status is not None:
+        text, failed = status_report(a.status)
+        print(text)
+        return 1 if failed else 0
     try:
         s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
                   feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format,
                   loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate, weld=a.weld,
-                  force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify,
-                  progress=not a.quiet and sys.stderr.isatty())
+                  force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify, dry_run=a.dry_run,
+                  lock=not a.no_lock, fsync=a.fsync, progress=not a.quiet and sys.stderr.isatty())
     except RuntimeError as e:
         raise PipelineError(str(e)) from None
+    if s.dry_run:
+        print(s.table(), file=sys.stderr)
+        return 0
     lines = s.failure_lines() if a.quiet else [s.table()]
     if lines:
         print("\n".join(lines), file=sys.stderr)
@@ -377,13 +385,14 @@ def _add_batch(sub) -> None:
     b = sub.add_parser("batch", help="subdivide many mesh files on Dask; a rerun skips what is done",
                        description="Subdivide every mesh of INPUTS (files, folders walked for mesh files, glob "
                                    "patterns — quote them) into OUTDIR, one Dask task per mesh, with the code of "
-                                   "'subdivide'. A manifest (OUTDIR/hybridsub-manifest.jsonl) records each mesh as "
+                                   "'subdivide'. A manifest (OUTDIR/hybridsub-manifest.sqlite) records each mesh as "
                                    "it finishes; running the same command again skips what is done and redoes the "
-                                   "rest. Needs Dask: pip install 'hybridsub[batch]'. See docs/batch.md.",
+                                   "rest; --status OUTDIR reports it. Needs Dask: pip install 'hybridsub[batch]'. "
+                                   "See docs/batch.md.",
                        epilog="Exit codes: 0 every mesh done or skipped, 1 some mesh failed (listed, and in the "
                               "manifest) or the batch could not run, 2 bad command line, 130 interrupted.")
-    b.add_argument("inputs", metavar="INPUT", nargs="+", help="mesh files, folders and glob patterns")
-    b.add_argument("-o", "--output", metavar="OUTDIR", required=True,
+    b.add_argument("inputs", metavar="INPUT", nargs="*", help="mesh files, folders and glob patterns")
+    b.add_argument("-o", "--output", metavar="OUTDIR",
                    help="output folder; outputs mirror the inputs' names below their folder or pattern")
     b.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     b.add_argument("--format", choices=("obj", "ply", "npz"), default="obj",
@@ -400,8 +409,17 @@ def _add_batch(sub) -> None:
                         "the manifest's")
     b.add_argument("--force", action="store_true",
                    help="run meshes whose memory estimate exceeds 80%% of their worker's memory limit")
+    b.add_argument("--dry-run", action="store_true",
+                   help="only say what would be done, redone and skipped: no cluster, nothing written")
+    b.add_argument("--status", metavar="OUTDIR",
+                   help="report the manifest of OUTDIR (meshes done and failed, the failures' messages) and exit")
+    b.add_argument("--no-lock", action="store_true",
+                   help="do not lock OUTDIR against a second batch (for file systems without locks: run one batch "
+                        "per OUTDIR)")
+    b.add_argument("--fsync", action="store_true",
+                   help="flush each output and manifest update to the disk (survives a power loss; slower)")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table; failures still listed")
-    b.set_defaults(func=cmd_batch)
+    b.set_defaults(func=cmd_batch, batch_parser=b)
 
 
 def _add_compare(sub) -> None:

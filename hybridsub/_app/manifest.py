@@ -1,247 +1,326 @@
-"""The files of a batch: its inputs expanded, their output names, the manifest, and which
-meshes an earlier run has done already.
+"""The manifest of a batch: ``OUTDIR/hybridsub-manifest.sqlite``, one row per input and
+options key, the output name each input owns, and the lock that keeps a second batch out.
 
-The manifest, ``OUTDIR/hybridsub-manifest.jsonl``, has one JSON record per mesh and run;
-only the client writes it, and it is locked while a batch runs. The decisions (names,
-resuming) are in ``docs/batch.md``.
+SQLite in WAL mode: only the client writes it, results in one transaction per batch of
+results; a rerun reads it in chunks of inputs (indexed by input), never whole. A JSON-lines
+manifest of an earlier version is migrated once. The decisions are in ``docs/batch.md``.
 """
 
 from __future__ import annotations
 
-import glob
-import hashlib
+import errno
 import json
 import os
-import re
-from collections.abc import Iterable
-from dataclasses import dataclass
+import sqlite3
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from urllib.parse import quote
 
-MANIFEST = "hybridsub-manifest.jsonl"
+MANIFEST = "hybridsub-manifest.sqlite"
+LEGACY_MANIFEST = "hybridsub-manifest.jsonl"
+LOCKFILE = "hybridsub-manifest.lock"
 TMPDIR = ".hybridsub-tmp"
-#: Extensions a directory or a pattern picks up (files named one by one may have any).
-MESH_EXTENSIONS = (".obj", ".ply", ".off", ".npz", ".stl", ".glb", ".gltf", ".3mf", ".dae", ".vtk", ".vtu")
-_MAGIC = re.compile(r"[*?[]")
+NO_LOCK_HINT = ("if no other batch writes to this folder, run with --no-lock (lock=False in Python), or write the "
+                "outputs to a file system with locks")
+#: flock's errors that mean "another process holds it" (the others: this file system has no locks)
+_HELD = (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
+_NO_LOCKS = (errno.ENOSYS, errno.EOPNOTSUPP, errno.ENOTSUP, errno.ENOLCK, errno.EINVAL)
+
+#: columns of a mesh row, in order; ``notes`` and ``seconds`` hold JSON
+COLUMNS = ("input", "options_key", "status", "reason", "output", "input_size", "input_mtime_ns", "input_sha256",
+           "output_size", "output_sha256", "faces_in", "faces_out", "vertices_out", "features", "notes", "seconds",
+           "worker", "error", "traceback", "run", "finished")
+_JSON = ("notes", "seconds")
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS options (options_key TEXT PRIMARY KEY, options TEXT NOT NULL, hybridsub TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS names (input TEXT PRIMARY KEY, stem TEXT NOT NULL, stem_cf TEXT NOT NULL UNIQUE)
+    WITHOUT ROWID;
+CREATE TABLE IF NOT EXISTS meshes ({", ".join(COLUMNS)}, PRIMARY KEY (input, options_key)) WITHOUT ROWID;
+CREATE INDEX IF NOT EXISTS meshes_by_status ON meshes (options_key, status);
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT);
+"""
 
 
-# ----------------------------------------------------------------------------------------------
-# inputs and output names
+class LockError(RuntimeError):
+    """OUTDIR is locked by another batch, or its file system cannot lock files."""
 
 
-@dataclass(frozen=True)
-class BatchInput:
-    """One input file of a batch and the stem of its output name."""
-
-    path: str  # absolute
-    stem: str  # output name without extension, relative to OUTDIR, '/'-separated
-
-
-def _within(path: str, folder: str) -> bool:
-    return os.path.commonpath([path, folder]) == folder
-
-
-def expand_inputs(inputs: Iterable[str | os.PathLike], outdir: str) -> tuple[list[BatchInput], int]:
-    """Files of the INPUTS in order (directories walked, patterns expanded, both sorted), each
-    once, with its output stem: a file's base name, or the path below the directory or the
-    pattern's fixed folder. ``outdir`` is not walked, and files a pattern finds in it are left
-    out (returns how many); an INPUT inside it is an error."""
-    real_out = os.path.realpath(outdir)
-    seen: set[str] = set()
-    found: list[BatchInput] = []
-    left_out = 0
-    if isinstance(inputs, (str, os.PathLike)):
-        inputs = [inputs]
-    for arg in inputs:
-        arg = os.fspath(arg)
-        if os.path.exists(arg) and _within(os.path.realpath(arg), real_out):
-            raise ValueError(f"{arg}: the input lies inside the output folder {outdir}; write to another folder")
-        if _MAGIC.search(arg) and not os.path.exists(arg):
-            parts = arg.replace(os.sep, "/").split("/")
-            fixed = "/".join(parts[:next(i for i, p in enumerate(parts) if _MAGIC.search(p))])
-            base = fixed if fixed else "."
-            if arg.startswith("/") and not fixed:
-                base = "/"
-            files = sorted(f for f in glob.glob(arg, recursive=True)
-                           if os.path.isfile(f) and f.lower().endswith(MESH_EXTENSIONS))
-            if not files:
-                raise FileNotFoundError(f"the pattern {arg!r} matches no mesh file ({', '.join(MESH_EXTENSIONS)})")
-            kept = [f for f in files if not _within(os.path.realpath(f), real_out)]
-            if not kept:
-                raise ValueError(f"the pattern {arg!r} matches only files inside the output folder {outdir}; "
-                                 "write to another folder")
-            left_out += len(files) - len(kept)
-            files = kept
-        elif os.path.isdir(arg):
-            base = arg
-            files = []
-            for root, dirs, names in os.walk(arg):
-                dirs[:] = sorted(d for d in dirs if not _within(os.path.realpath(os.path.join(root, d)), real_out))
-                files += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(MESH_EXTENSIONS)]
-            if not files:
-                raise FileNotFoundError(f"{arg}: the folder holds no mesh file ({', '.join(MESH_EXTENSIONS)})")
-        elif os.path.exists(arg):
-            base, files = os.path.dirname(arg) or ".", [arg]
-        else:
-            raise FileNotFoundError(f"{arg}: no such file or directory")
-        for f in files:
-            path = os.path.abspath(f)
-            if path in seen:
-                continue
-            seen.add(path)
-            rel = os.path.relpath(f, base).replace(os.sep, "/")
-            if rel.startswith("../") or rel == "..":
-                rel = os.path.basename(f)
-            found.append(BatchInput(path, os.path.splitext(rel)[0]))
-    return found, left_out
+def _lock(path: str) -> int | None:
+    """An fd holding an exclusive ``flock`` on ``path`` (None where there is no ``fcntl``)."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: no advisory locks; one batch per folder is then up to the user
+        return None
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        os.close(fd)
+        folder = os.path.dirname(path)
+        if e.errno in _HELD:
+            raise LockError(f"{folder} is locked: another hybridsub batch is writing to this folder; wait for it, "
+                            "or use another output folder") from None
+        if e.errno in _NO_LOCKS:
+            raise LockError(f"{folder}: this file system has no file locks ({e.strerror}), so hybridsub cannot "
+                            f"keep a second batch out; {NO_LOCK_HINT}") from None
+        raise LockError(f"{folder}: cannot lock {os.path.basename(path)}: {e.strerror}") from None
+    return fd
 
 
-def assign_outputs(items: list[BatchInput], fmt: str, owners: dict[str, str], previous: dict[str, str]) -> list[str]:
-    """Output names (relative to OUTDIR) for ``items``, never two alike (compared without
-    case). An input keeps the name the manifest gave it before (``previous``: input → output);
-    a new input takes ``STEM.FMT`` unless another input has it, in this run or in the manifest
-    (``owners``: casefolded name → input), and then ``STEM-HASH.FMT``, HASH from its path."""
-    taken = dict(owners)
-    names: list[str | None] = [None] * len(items)
-
-    def free(name: str, path: str) -> bool:
-        return taken.get(name.casefold(), path) == path
-
-    for i, it in enumerate(items):
-        prev = previous.get(it.path)
-        if prev is not None:
-            name = f"{os.path.splitext(prev)[0]}.{fmt}"
-            if free(name, it.path):
-                names[i] = name
-                taken[name.casefold()] = it.path
-    for i, it in enumerate(items):
-        if names[i] is not None:
-            continue
-        name = f"{it.stem}.{fmt}"
-        digest = hashlib.sha1(it.path.encode("utf-8", "surrogateescape")).hexdigest()
-        for width in (8, 16, 40):
-            if free(name, it.path):
-                break
-            name = f"{it.stem}-{digest[:width]}.{fmt}"
-        names[i] = name
-        taken[name.casefold()] = it.path
-    return names
-
-
-# ----------------------------------------------------------------------------------------------
-# the manifest
-
-
+@dataclass
 class Manifest:
-    """``OUTDIR/hybridsub-manifest.jsonl``, locked while a batch runs. Reading keeps the last
-    record of each (input, options key); a torn last line (a killed writer) is cut off, other
-    unreadable lines are skipped. ``append`` writes whole lines and fsyncs."""
+    """The manifest of ``outdir``, open. ``readonly``: the dry run's and ``--status``'s view
+    (no lock, nothing written; a JSON-lines manifest is migrated into memory). ``lock=False``:
+    no ``flock``, and SQLite without locks (for file systems that have none)."""
 
-    def __init__(self, outdir: str):
-        self.path = os.path.join(outdir, MANIFEST)
-        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_APPEND, 0o644)
+    outdir: str
+    readonly: bool = False
+    lock: bool = True
+    durable: bool = False
+    notes: list[str] = field(default_factory=list)
+
+    def __post_init__(self):
+        self.path = os.path.join(self.outdir, MANIFEST)
+        self._lockfd = None
+        self._new_owners: dict[str, str] = {}  # the dry run's names (nothing is written): stem_cf → input
+        self._new_stems: dict[str, str] = {}  # input → stem
+        self._dedupe_table = False
+        if not self.readonly and self.lock:
+            self._lockfd = _lock(os.path.join(self.outdir, LOCKFILE))
         try:
-            self._lock()
-            self.notes: list[str] = []
-            self.records: dict[tuple[str, str], dict] = {}
-            self._read()
+            self.db = self._connect()
         except BaseException:
-            os.close(self.fd)
+            self._unlock()
             raise
 
-    def _lock(self) -> None:
-        try:
-            import fcntl
-        except ImportError:  # Windows: no advisory locks; one batch per folder is then up to the user
+    def _connect(self) -> sqlite3.Connection:
+        legacy = os.path.join(self.outdir, LEGACY_MANIFEST)
+        exists = os.path.exists(self.path)
+        uri = f"file:{quote(self.path)}" + ("" if self.lock or self.readonly else "?vfs=unix-none")
+        if self.readonly and not exists:
+            uri = "file::memory:"
+        try:  # a read-only view opens read-write too (never writing), so that closing it removes the WAL files
+            db = sqlite3.connect(uri, uri=True, isolation_level=None, check_same_thread=False)
+            if self.readonly and exists:
+                db.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        except sqlite3.OperationalError:
+            if not (self.readonly and exists):
+                raise
+            db = sqlite3.connect(f"file:{quote(self.path)}?mode=ro", uri=True, isolation_level=None,
+                                 check_same_thread=False)
+        db.execute("PRAGMA busy_timeout = 30000")
+        if not self.readonly:
+            if not self.lock:
+                db.execute("PRAGMA locking_mode = EXCLUSIVE")  # WAL without shared memory
+            db.execute("PRAGMA journal_mode = WAL")
+            db.execute(f"PRAGMA synchronous = {'FULL' if self.durable else 'NORMAL'}")
+        if not exists:
+            db.executescript(_SCHEMA)
+        if os.path.exists(legacy) and (not exists or not self.readonly):
+            self._migrate(db, legacy)
+        return db
+
+    def _migrate(self, db: sqlite3.Connection, legacy: str) -> None:
+        """Read the JSON-lines manifest of hybridsub < 0.2 once: its last record of each
+        (input, options key) becomes a row, each input keeps its output name; the file is then
+        renamed ``….jsonl.migrated`` (kept in memory only, for a read-only view)."""
+        if db.execute("SELECT 1 FROM meta WHERE key = 'migrated'").fetchone():
+            os.replace(legacy, legacy + ".migrated")  # migrated, renaming interrupted
             return
-        try:
-            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise RuntimeError(f"{self.path} is locked: another hybridsub batch is writing to this folder; "
-                               "wait for it, or use another output folder") from None
+        n = bad = 0
+        db.execute("BEGIN")
+        with open(legacy, "rb") as fh:
+            for line in fh:
+                try:
+                    rec = json.loads(line)
+                    rec["input"], rec["options_key"]
+                except (ValueError, KeyError, TypeError):
+                    bad += line.strip() != b""
+                    continue
+                if isinstance(rec.get("options"), dict):
+                    db.execute("INSERT OR IGNORE INTO options VALUES (?, ?, ?)",
+                               (rec["options_key"], json.dumps(rec["options"]), rec.get("hybridsub", "")))
+                self._put_name(db, rec)
+                db.execute(_UPSERT, _row(rec))
+                n += 1
+        db.execute("INSERT INTO meta VALUES ('migrated', ?)", (LEGACY_MANIFEST,))
+        db.execute("COMMIT")
+        if not self.readonly:
+            os.replace(legacy, legacy + ".migrated")
+        self.notes.append(f"migrated {n:,} records of {LEGACY_MANIFEST} into {MANIFEST}"
+                          + (f" ({bad:,} unreadable lines skipped)" if bad else "")
+                          + ("" if self.readonly else f"; the old file is kept as {LEGACY_MANIFEST}.migrated"))
 
-    def _read(self) -> None:
-        with open(self.path, "rb") as fh:
-            data = fh.read()
-        end = data.rfind(b"\n") + 1
-        if end < len(data):  # a line without its newline: the writer was killed in the middle of it
-            os.ftruncate(self.fd, end)
-            self.notes.append(f"cut off a torn last line of {MANIFEST} ({len(data) - end} bytes)")
-            data = data[:end]
-        bad = 0
-        for line in data.splitlines():
-            try:
-                rec = json.loads(line)
-                key = (rec["input"], rec["options_key"])
-            except (ValueError, KeyError, TypeError):
-                bad += line.strip() != b""
-                continue
-            self.records[key] = rec
-        if bad:
-            self.notes.append(f"skipped {bad} unreadable lines of {MANIFEST}")
+    @staticmethod
+    def _put_name(db, rec: dict) -> None:
+        out = rec.get("output")
+        if isinstance(out, str):
+            stem = os.path.splitext(out)[0]
+            db.execute("INSERT OR REPLACE INTO names VALUES (?, ?, ?)", (rec["input"], stem, stem.casefold()))
 
-    def owners(self) -> tuple[dict[str, str], dict[str, str]]:
-        """Casefolded output name → input, and input → its latest output name."""
-        owners, previous = {}, {}
-        for (path, _), rec in self.records.items():
-            out = rec.get("output")
-            if isinstance(out, str):
-                owners[out.casefold()] = path
-                previous[path] = out
-        return owners, previous
+    # ------------------------------------------------------------------------------------------
+    # reading, a chunk of inputs at a time
 
-    def append(self, records: list[dict]) -> None:
-        if not records:
+    def lookup(self, inputs: list[str], key: str) -> tuple[dict[str, tuple], dict[str, str], set[str]]:
+        """For ``inputs``: what planning needs of their rows under ``key``, ``input → (status,
+        input_size, input_mtime_ns, output, output_size)``; the stems they own; and, of those
+        without such a row, the ones with a row under another key."""
+        marks = ",".join("?" * len(inputs))
+        rows = {r[0]: r[1:] for r in self.db.execute(
+            "SELECT input, status, input_size, input_mtime_ns, output, output_size FROM meshes "
+            f"WHERE options_key = ? AND input IN ({marks})", [key, *inputs])}
+        stems = dict(self.db.execute(f"SELECT input, stem FROM names WHERE input IN ({marks})", inputs))
+        if self._new_stems:
+            stems.update((p, self._new_stems[p]) for p in inputs if p in self._new_stems)
+        seen = set()
+        if len(rows) < len(inputs):
+            rest = [p for p in inputs if p not in rows]
+            seen = {r[0] for r in self.db.execute(
+                f"SELECT DISTINCT input FROM meshes WHERE input IN ({','.join('?' * len(rest))})", rest)}
+        return rows, stems, seen
+
+    def record_of(self, path: str, key: str) -> dict | None:
+        """The row of input ``path`` under options ``key``, as a record."""
+        row = self.db.execute(f"SELECT {', '.join(COLUMNS)} FROM meshes WHERE input = ? AND options_key = ?",
+                              (path, key)).fetchone()
+        return _record(row) if row else None
+
+    def owner(self, stem: str) -> str | None:
+        """The input that owns the output stem (compared without case), if any."""
+        cf = stem.casefold()
+        if cf in self._new_owners:
+            return self._new_owners[cf]
+        row = self.db.execute("SELECT input FROM names WHERE stem_cf = ?", (cf,)).fetchone()
+        return row[0] if row else None
+
+    def first_seen(self, items: list) -> list:
+        """The ``items`` (with a ``path``) whose path this run has not met before (a file given
+        twice, by two INPUTS), remembered in a temporary table, not in memory."""
+        if not self._dedupe_table:
+            self.db.execute("CREATE TEMP TABLE IF NOT EXISTS run_inputs (input TEXT PRIMARY KEY) WITHOUT ROWID")
+            self._dedupe_table = True
+        keep = []
+        for it in items:
+            if self.db.execute("INSERT OR IGNORE INTO temp.run_inputs VALUES (?)", (it.path,)).rowcount:
+                keep.append(it)
+        return keep
+
+    def take_names(self, names: Iterable[tuple[str, str]]) -> None:
+        """Record that each input owns its stem, ``(input, stem)``, in one transaction."""
+        rows = [(p, s, s.casefold()) for p, s in names]
+        if self.readonly:
+            for p, s, cf in rows:
+                self._new_owners[cf] = p
+                self._new_stems[p] = s
             return
-        data = b"".join(json.dumps(r, ensure_ascii=False, allow_nan=False).encode() + b"\n" for r in records)
-        view = memoryview(data)
-        while view:
-            view = view[os.write(self.fd, view):]
-        os.fsync(self.fd)
+        with self.db:
+            self.db.executemany("INSERT OR REPLACE INTO names VALUES (?, ?, ?)", rows)
+
+    def records(self, key: str | None = None, status: str | None = None) -> Iterator[dict]:
+        """Every row (of options ``key``, of ``status``) as a record, streamed, in input order."""
+        where = " AND ".join(w for w, v in (("m.options_key = ?", key), ("m.status = ?", status)) if v is not None)
+        args = [v for v in (key, status) if v is not None]
+        cur = self.db.execute(f"SELECT {', '.join('m.' + c for c in COLUMNS)}, o.options, o.hybridsub FROM meshes m "
+                              f"LEFT JOIN options o USING (options_key){' WHERE ' + where if where else ''} "
+                              "ORDER BY m.input, m.options_key", args)
+        for row in cur:
+            rec = _record(row[:len(COLUMNS)])
+            rec["options"] = json.loads(row[-2]) if row[-2] else None
+            rec["hybridsub"] = row[-1]
+            yield rec
+
+    def counts(self) -> list[tuple[str, dict, str, dict[str, int], int, str]]:
+        """Per options key: (key, options, hybridsub version, rows by status, output faces of the
+        done meshes, last finished)."""
+        out = {}
+        for key, opts, version in self.db.execute("SELECT options_key, options, hybridsub FROM options"):
+            out[key] = [key, json.loads(opts), version, {}, 0, ""]
+        for key, status, n, faces, last in self.db.execute(
+                "SELECT options_key, status, count(*), total(faces_out), max(finished) FROM meshes "
+                "GROUP BY options_key, status"):
+            entry = out.setdefault(key, [key, {}, "", {}, 0, ""])
+            entry[3][status] = n
+            entry[4] += int(faces) if status == "done" else 0
+            entry[5] = max(entry[5], last or "")
+        return [tuple(v) for v in out.values() if v[3]]
+
+    # ------------------------------------------------------------------------------------------
+    # writing
+
+    def add_options(self, key: str, options: dict, version: str) -> None:
+        if not self.readonly:
+            with self.db:
+                self.db.execute("INSERT OR IGNORE INTO options VALUES (?, ?, ?)", (key, json.dumps(options), version))
+
+    def record(self, records: list[dict]) -> None:
+        """Write ``records`` (one row each, replacing the input's row of that options key) in one
+        transaction."""
+        if records and not self.readonly:
+            with self.db:
+                self.db.executemany(_UPSERT, [_row(r) for r in records])
 
     def close(self) -> None:
-        os.close(self.fd)  # releases the lock
+        try:
+            self.db.close()
+        finally:
+            self._unlock()
+
+    def _unlock(self) -> None:
+        if self._lockfd is not None:
+            os.close(self._lockfd)  # releases the lock
+            self._lockfd = None
+
+
+_UPSERT = f"INSERT OR REPLACE INTO meshes VALUES ({', '.join('?' * len(COLUMNS))})"
+
+
+def _row(rec: dict) -> tuple:
+    return tuple(json.dumps(rec.get(c)) if c in _JSON else rec.get(c) for c in COLUMNS)
+
+
+def _record(row) -> dict:
+    rec = dict(zip(COLUMNS, row))
+    for c in _JSON:
+        rec[c] = json.loads(rec[c]) if rec[c] is not None else None
+    return rec
+
+
+def is_disk_full(exc: BaseException) -> bool:
+    """True for the errors of a full disk or an exceeded quota (the OS's, and SQLite's)."""
+    if isinstance(exc, OSError):
+        return exc.errno in (errno.ENOSPC, errno.EDQUOT)
+    return isinstance(exc, sqlite3.OperationalError) and getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL
 
 
 # ----------------------------------------------------------------------------------------------
-# what is done already
+# --status
 
 
-def options_key(options: dict, version: str) -> str:
-    """What makes two runs' outputs of one input the same: the options and hybridsub's version."""
-    text = json.dumps(dict(options, hybridsub=version), sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def plan_item(item: BatchInput, output: str, outdir: str, prev: dict | None, seen_input: bool, verify: bool):
-    """(skip, reason): whether ``item`` is done already, and why it must run otherwise."""
-    if prev is None:
-        return False, "options changed" if seen_input else "new"
-    if prev.get("status") != "done":
-        return False, "failed before"
+def status_report(outdir: str | os.PathLike, max_failures: int = 20) -> tuple[str, int]:
+    """(the text ``hybridsub batch --status OUTDIR`` prints, how many meshes failed): per options
+    key the meshes done and failed, and the failures' messages."""
+    outdir = os.path.abspath(os.fspath(outdir))
+    if not (os.path.exists(os.path.join(outdir, MANIFEST)) or os.path.exists(os.path.join(outdir, LEGACY_MANIFEST))):
+        raise FileNotFoundError(f"{outdir}: no batch manifest here ({MANIFEST})")
+    m = Manifest(outdir, readonly=True)
     try:
-        st = os.stat(item.path)
-    except OSError:
-        return False, "input changed"
-    if (st.st_size, st.st_mtime_ns) != (prev.get("input_size"), prev.get("input_mtime_ns")):
-        return False, "input changed"
-    if prev.get("output") != output:
-        return False, "output name changed"
-    try:
-        size = os.path.getsize(os.path.join(outdir, output))
-    except OSError:
-        return False, "output missing"
-    if size != prev.get("output_size"):
-        return False, "output changed"
-    return not verify, "verify"  # skip, or have a worker compare checksums
-
-
-def clean_tmpdir(tmpdir: str) -> int:
-    """Remove what killed tasks left in OUTDIR/.hybridsub-tmp; returns how many files."""
-    removed = 0
-    for entry in os.scandir(tmpdir):
-        if entry.is_file(follow_symlinks=False):
-            try:
-                os.remove(entry.path)
-                removed += 1
-            except FileNotFoundError:  # a task of an earlier, orphaned run finishing right now
-                pass
-    return removed
+        lines = [f"hybridsub batch --status: {m.path}"] + [f"note: {n}" for n in m.notes]
+        failed_total = 0
+        for key, options, version, by_status, faces, last in sorted(m.counts(), key=lambda c: c[5], reverse=True):
+            opts = ", ".join(f"{k} {v}" for k, v in options.items() if v not in (None, False))
+            lines.append(f"options {key}: {opts or '?'}; hybridsub {version or '?'}; last finished {last or '-'}")
+            lines.append(f"  done     {by_status.get('done', 0):>10,}   {faces:,} output faces")
+            failed = by_status.get("failed", 0)
+            failed_total += failed
+            lines.append(f"  failed   {failed:>10,}")
+            for k, rec in enumerate(m.records(key, "failed")):
+                if k == max_failures:
+                    lines.append(f"  … and {failed - max_failures:,} more failures")
+                    break
+                err = rec["error"] or "?"
+                lines.append(f"  failed: {err if err.startswith(rec['input']) else rec['input'] + ': ' + err}")
+        if len(lines) == 1 + len(m.notes):
+            lines.append("  (no meshes recorded yet)")
+        return "\n".join(lines), failed_total
+    finally:
+        m.close()

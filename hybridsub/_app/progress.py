@@ -141,22 +141,26 @@ class ProgressBar(_StatusLine):
 
 class BatchProgress(_StatusLine):
     """One line on stderr for ``hybridsub batch``, redrawn as meshes finish (at most ten times a
-    second): bar and count of meshes finished (done or skipped) out of all, failures, meshes
-    and output faces per second of wall time. Silent unless enabled."""
+    second): bar and count of meshes finished (done or skipped) out of those found so far
+    (``+`` while the inputs are still being walked), failures, output faces per second of wall
+    time. Silent unless enabled."""
 
     def __init__(self, total: int, enabled: bool, stream=None):
         super().__init__("batch", enabled, stream)
         self.total = total
         self.last = -1.0
 
-    def update(self, finished: int, failed: int, faces: int, seconds: float) -> None:
+    def update(self, finished: int, failed: int, faces: int, seconds: float, total: int | None = None,
+               planning: bool = False) -> None:
+        if total is not None:
+            self.total = total
         if not self.enabled:
             return
         now = time.perf_counter()
-        if finished + failed < self.total and now - self.last < 0.1:
+        if (planning or finished + failed < self.total) and now - self.last < 0.1:
             return
         self.last = now
-        info = f"{finished + failed:,}/{self.total:,} meshes"
+        info = f"{finished + failed:,}/{self.total:,}{'+' if planning else ''} meshes"
         if failed:
             info += f" ({failed:,} failed)"
         if seconds > 0:
