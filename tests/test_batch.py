@@ -745,7 +745,7 @@ def test_run_task_records_what_went_wrong(tmp_path, monkeypatch):
 
 
 def test_obj_with_materials_names_its_mtl_as_subdivide(cluster, tmp_path):
-    """The output is written beside its final name, so 'mtllib' is relative to the output's folder,
+    """The output is written beside its final name, so its 'mtllib' line and the copied library are
     byte for byte what 'hybridsub subdivide' writes (it was relative to the temporary folder)."""
     (tmp_path / "in" / "parts").mkdir(parents=True)
     (tmp_path / "in" / "mats.mtl").write_text("newmtl red\nKd 1 0 0\n")
@@ -756,7 +756,9 @@ def test_obj_with_materials_names_its_mtl_as_subdivide(cluster, tmp_path):
     s = hybridsub.batch(tmp_path / "in", tmp_path / "out", scheduler=cluster, levels=1)
     assert (s.done, s.failed) == (1, 0)
     out = (tmp_path / "out" / "parts" / "a.obj").read_bytes()
-    assert b"mtllib ../../in/mats.mtl\n" in out and out == ref.read_bytes()
+    # the material library is copied beside the output, as subdivide does, not named relative to a temporary folder
+    assert b"mtllib mats.mtl\n" in out and out == ref.read_bytes()
+    assert (tmp_path / "out" / "parts" / "mats.mtl").read_text() == "newmtl red\nKd 1 0 0\n"
 
 
 def _patch_full_disk():  # runs on the workers: the task for m3 finds the disk full
@@ -813,12 +815,12 @@ def test_dry_run_and_status(tmp_path, capsys):
     outdir = tmp_path / "out"
     assert main(["batch", str(tmp_path / "in"), "-o", str(outdir), "--dry-run"]) == 0
     assert "would do          4   new" in capsys.readouterr().err and not outdir.exists()
-    key = _batch.options_key(_batch.batch_options(3, "hybrid", None, None, "loop", "obj", False, False, False, None),
+    key = _batch.options_key(_batch.batch_options(1, "hybrid", None, None, "loop", "obj", False, False, False, None),
                              hybridsub.__version__)
     os.makedirs(outdir)
     m = Manifest(str(outdir))
     try:  # as a run would leave it: m0 done, m1 done but its output deleted since, bad failed
-        m.add_options(key, {"levels": 3}, hybridsub.__version__)
+        m.add_options(key, {"levels": 1}, hybridsub.__version__)
         for i, (name, status) in enumerate((("m0", "done"), ("m1", "done"), ("bad", "failed"))):
             src = str(tmp_path / "in" / f"{name}.obj")
             m.take_names([(src, name)])
@@ -837,7 +839,7 @@ def test_dry_run_and_status(tmp_path, capsys):
         "would redo        2   1 output missing, 1 failed before" in err, err
     assert main(["batch", "--status", str(outdir)]) == 1  # some mesh failed
     out = capsys.readouterr().out
-    assert f"options {key}: levels 3;" in out and "last finished t2" in out
+    assert f"options {key}: levels 1;" in out and "last finished t2" in out
     assert "  done              2   8 output faces" in out and "  failed            1" in out
     assert f"failed: {tmp_path / 'in' / 'bad.obj'}: not a triangle mesh" in out
     for argv in (["--status", str(outdir), str(tmp_path / "in")], [str(tmp_path / "in")]):
@@ -870,7 +872,7 @@ def test_window_follows_the_cluster_threads():
 
 def _done_manifest(root, n):
     """n inputs all done (as a run records them), and their outputs."""
-    key = _batch.options_key(_batch.batch_options(3, "hybrid", None, None, "loop", "obj", False, False, False, None),
+    key = _batch.options_key(_batch.batch_options(1, "hybrid", None, None, "loop", "obj", False, False, False, None),
                              hybridsub.__version__)
     os.makedirs(os.path.join(root, "in"))
     os.makedirs(os.path.join(root, "out"))
