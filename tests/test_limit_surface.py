@@ -155,3 +155,15 @@ def test_bad_points_are_named():
         s.evaluate([0], [[1, 0, 0]], vertices=np.zeros((5, 3)))
     with pytest.raises(hybridsub.MeshError):
         hybridsub.LimitSurface(OCTA_V, OCTA_F, sharp_edges=[[0, 1]])  # not an edge
+
+
+@pytest.mark.parametrize("scheme", ["sqrt3", "loop"])
+def test_deeper_levels_are_exact_too(scheme):
+    """Levels 3 and 4: refined faces reach round input vertices (the chart unfolds there)."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])  # valence 3: the chart is far from flat
+    for levels in (3, 4):
+        r = hybridsub.refine(F, levels=levels, scheme=scheme)
+        s = hybridsub.LimitSurface(V, F, scheme=scheme, depth=levels)
+        ref = hybridsub.limit_positions(V, F, levels=levels, scheme=scheme)
+        assert np.abs(s.evaluate(*r.vertex_origin) - ref).max() < 1e-12

@@ -145,42 +145,38 @@ def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.
                  sup_ids: np.ndarray, sup_w: np.ndarray) -> np.ndarray:
     """Each child face's corners (m', 3, 2) in its parent's frame.
 
-    ``faces1`` and ``parent`` may be any subset of the next level's faces. A child's corners
-    are chart combinations of its parent's corners and of the far corners of the parent's
-    edge-neighbours (face points of the neighbours, Kobbelt's apexes).
+    ``faces1`` and ``parent`` may be any subset of the next level's faces. A child's corner is
+    a chart combination of the corners of one face: its parent, or one of the parent's
+    edge-neighbours glued onto it (a neighbour's face point, Kobbelt's apexes). The first
+    of those four faces that holds every support is used: around a vertex of low valence the
+    chart is not flat, and the same vertex glued through two neighbours lies in two places.
     """
     parents, pi = np.unique(parent, return_inverse=True)
-    nb = glue(shape, twin, F, parents)  # (p, 3, 3, 2): neighbour i's corners, parent frame
+    nb = np.nan_to_num(glue(shape, twin, F, parents))  # (p, 3, 3, 2): neighbour i's corners, parent frame
     tw = twin[3 * parents[:, None] + np.arange(3)]
     g = np.where(tw >= 0, tw // 3, 0)
-    far_local = np.where(tw >= 0, (tw % 3 + 2) % 3, 0)
-    kp = np.arange(len(parents))
-    far_pos = np.nan_to_num(nb[kp[:, None], np.arange(3)[None], far_local])
-    cand_ids = np.concatenate([F[parents], np.where(tw >= 0, F[g, far_local], -1)], axis=1)[pi]  # (m', 6)
-    cand_pos = np.concatenate([shape[parents], far_pos], axis=1)[pi]  # (m', 6, 2)
+    nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
+    group_ids = np.concatenate([F[parents][:, None], nb_ids], axis=1)[pi]  # (m', 4, 3)
+    group_pos = np.concatenate([shape[parents][:, None], nb], axis=1)[pi]  # (m', 4, 3, 2)
     ids = sup_ids[faces1]  # (m', 3 corners, 3 supports)
     ws = sup_w[faces1]
-    match = ids[..., None] == cand_ids[:, None, None, :]  # (m', 3, 3, 6)
-    found = match.any(-1) | (ids < 0)
-    if not found.all():  # pragma: no cover - the emission patterns guarantee it
+    match = ids[:, :, :, None, None] == group_ids[:, None, None]  # (m', 3, 3, 4, 3)
+    holds = (match.any(-1) | (ids < 0)[..., None]).all(axis=2)  # (m', 3, 4): group holds every support
+    if not holds.any(-1).all():  # pragma: no cover - the emission patterns guarantee it
         raise AssertionError("a child corner is not a combination of its parent's neighbourhood")
-    which = match.argmax(-1)
+    grp = holds.argmax(-1)  # (m', 3)
     k = np.arange(len(faces1))
-    pos = cand_pos[k[:, None, None], which]
+    which = np.take_along_axis(match, grp[:, :, None, None, None], axis=3)[:, :, :, 0].argmax(-1)  # (m', 3, 3)
+    pos = group_pos[k[:, None, None], grp[:, :, None], which]  # (m', 3, 3, 2)
     return (ws[..., None] * pos).sum(axis=2)
 
 
-def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: np.ndarray):
-    """Points given in an input face's rhombus chart moved onto an input face that contains them.
-
-    A point with a negative coordinate lies across the edge opposite that corner: it is
-    expressed over the face across (the rhombus's other triangle). Tiny negatives are rounding.
-    """
-    face, bary = face.copy(), bary.copy()
+def _across(face, bary, twin0, tol):
+    """One reflection: points with a coordinate below ``-tol`` expressed over the face across
+    the edge opposite that corner (the rhombus's other triangle); boundary points stay."""
     j = np.argmin(bary, axis=1)
-    out = bary[np.arange(len(bary)), j] < -1e-12
-    h = 3 * face[out] + (j[out] + 1) % 3
-    t = twin0[h]
+    out = bary[np.arange(len(bary)), j] < -tol
+    t = twin0[3 * face[out] + (j[out] + 1) % 3]
     ok = t >= 0
     idx = np.flatnonzero(out)[ok]
     t, jj = t[ok], j[out][ok]
@@ -191,6 +187,21 @@ def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: 
     a = t % 3  # the face across: its corner a is our corner j + 2, a + 1 is j + 1, a + 2 the far one
     nb[r, a], nb[r, (a + 1) % 3], nb[r, (a + 2) % 3] = bj2 + bj, bj1 + bj, -bj
     face[idx], bary[idx] = t // 3, nb
+    return len(idx) > 0
+
+
+def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: np.ndarray, max_faces: int = 8):
+    """Points given in an input face's unfolded chart moved onto an input face that contains them.
+
+    A point with a negative coordinate lies across the edge opposite that corner: it is
+    expressed over the face across, and again from there (a point near a vertex may be
+    several faces round it), at most ``max_faces`` times; at the boundary it is clamped onto
+    the face. Tiny negatives are rounding.
+    """
+    face, bary = face.copy(), bary.copy()
+    for _ in range(max_faces):
+        if not _across(face, bary, twin0, 1e-12):
+            break
     bary = np.clip(bary, 0.0, None)
     return face, bary / bary.sum(axis=1, keepdims=True)
 

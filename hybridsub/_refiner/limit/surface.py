@@ -149,11 +149,12 @@ class LimitSurface:
         Examples
         --------
         >>> import numpy as np, hybridsub
-        >>> V, F = hybridsub.load_example()
-        >>> s = hybridsub.LimitSurface(V, F)
-        >>> M = s.evaluation_matrix([0, 5], [[0.2, 0.3, 0.5], [1, 0, 0]])
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> s = hybridsub.LimitSurface(V, F, sharp_edges=[[0, 1]])
+        >>> M = s.evaluation_matrix([0, 3], [[0.2, 0.3, 0.5], [1, 0, 0]])
         >>> M.shape, bool(np.allclose(M.sum(axis=1), 1))
-        ((2, 6475), True)
+        ((2, 4), True)
         """
         f, b = self._points(face, bary)
         parts = [[] for _ in range(3 if derivatives else 1)]
@@ -177,11 +178,14 @@ class LimitSurface:
         Examples
         --------
         >>> import numpy as np, hybridsub
-        >>> V, F = hybridsub.load_example()
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
         >>> s = hybridsub.LimitSurface(V, F, scheme="loop")
-        >>> P, Du, Dv = s.evaluate([7], [[0.25, 0.25, 0.5]], derivatives=True)
+        >>> P, Du, Dv = s.evaluate([3], [[0.25, 0.25, 0.5]], derivatives=True)
         >>> P.shape, Du.shape
         ((1, 3), (1, 3))
+        >>> bool(np.allclose(s.evaluate([3], [[0.25, 0.25, 0.5]], vertices=2 * V), 2 * P))
+        True
         """
         X = self._data(vertices)
         mats = self.evaluation_matrix(face, bary, derivatives)
@@ -195,10 +199,11 @@ class LimitSurface:
         Examples
         --------
         >>> import numpy as np, hybridsub
-        >>> V, F = hybridsub.load_example()
-        >>> N = hybridsub.LimitSurface(V, F).normals([3], [[0.2, 0.2, 0.6]])
-        >>> bool(np.isclose(np.linalg.norm(N), 1))
-        True
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> N = hybridsub.LimitSurface(V, F).normals([3], [[1/3, 1/3, 1/3]])
+        >>> N.round(6).tolist()                       # the face (1, 2, 3) faces away from 0
+        [[0.57735, 0.57735, 0.57735]]
         """
         _, Du, Dv = self.evaluate(face, bary, derivatives=True, vertices=vertices)
         N = np.cross(Du, Dv)
@@ -215,12 +220,13 @@ class LimitSurface:
         Examples
         --------
         >>> import numpy as np, hybridsub
-        >>> V, F = hybridsub.load_example()
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
         >>> s = hybridsub.LimitSurface(V, F)
-        >>> P = s.evaluate([100], [[0.3, 0.3, 0.4]]); N = s.normals([100], [[0.3, 0.3, 0.4]])
+        >>> P = s.evaluate([3], [[0.3, 0.3, 0.4]]); N = s.normals([3], [[0.3, 0.3, 0.4]])
         >>> face, bary, Q, dist = s.project(P + 0.01 * N)
-        >>> bool(np.allclose(Q, P, atol=1e-8)), bool(np.isclose(dist[0], 0.01))
-        True
+        >>> bool(np.allclose(Q, P, atol=1e-12)), bool(np.isclose(dist[0], 0.01, atol=1e-12))
+        (True, True)
         """
         X = self._V if vertices is None else as_vertices(vertices)
         if len(X) != self._inp.n_vertices:
