@@ -17,6 +17,14 @@ from ..._topology import build_level
 
 #: Levels of the refined mesh whose limit points seed the search.
 SEED_LEVELS = 2
+#: Depth of the descent while the foot point is still far (the last iterations use the full depth).
+COARSE_DEPTH = 8
+#: The coarse iterations stop at this step size in (u, v), the fine ones at FINE_STEP.
+COARSE_STEP, FINE_STEP = 1e-7, 1e-11
+#: The longest Gauss–Newton step in (u, v).
+MAX_STEP = 0.5
+#: At most this many iterations at the full depth (each costs a full descent).
+FINE_ITER = 6
 
 
 def seed_setup(inp: RefineInput):
@@ -66,27 +74,31 @@ def _move(face, bary, du, dv, twin0, F0):
     return face, nb
 
 
-def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
-    """``(face, bary, Q, dist)`` of the points ``pts`` on the limit surface of ``surface`` with controls ``X``."""
-    M, sf, sb = surface._seed_setup()
+def _iterate(surface, X, pts, face, bary, depth, max_iter, stop):
+    """Gauss–Newton iterations at one descent depth, each point until its step is below ``stop``."""
     inp = surface._inp
     twin0, F0 = inp.level.twin, inp.faces
-    S = M @ X
-    _, near = cKDTree(S).query(pts)
-    face, bary = sf[near].copy(), sb[near].copy()
     active = np.ones(len(pts), dtype=bool)
-    step_max = 0.5
     for _ in range(max_iter):
         idx = np.flatnonzero(active)
         if not len(idx):
             break
-        P, Du, Dv = surface.evaluate(face[idx], bary[idx], derivatives=True, vertices=X)
-        du, dv = _newton_step(P, Du, Dv, pts[idx])
+        M, Mu, Mv = surface._matrix(face[idx], bary[idx], True, depth)
+        du, dv = _newton_step(M @ X, Mu @ X, Mv @ X, pts[idx])
         size = np.hypot(du, dv)
-        scale = np.minimum(1.0, step_max / np.maximum(size, 1e-300))
-        du, dv = du * scale, dv * scale
-        face[idx], bary[idx] = _move(face[idx], bary[idx], du, dv, twin0, F0)
-        active[idx[size < 1e-13]] = False
+        scale = np.minimum(1.0, MAX_STEP / np.maximum(size, 1e-300))
+        face[idx], bary[idx] = _move(face[idx], bary[idx], du * scale, dv * scale, twin0, F0)
+        active[idx[size < stop]] = False
+    return face, bary
+
+
+def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
+    """``(face, bary, Q, dist)`` of the points ``pts`` on the limit surface of ``surface`` with controls ``X``."""
+    M, sf, sb = surface._seed_setup()
+    _, near = cKDTree(M @ X).query(pts)
+    face, bary = sf[near].copy(), sb[near].copy()
+    face, bary = _iterate(surface, X, pts, face, bary, min(COARSE_DEPTH, surface.depth), max_iter, COARSE_STEP)
+    face, bary = _iterate(surface, X, pts, face, bary, surface.depth, min(max_iter, FINE_ITER), FINE_STEP)
     Q, Du, Dv = surface.evaluate(face, bary, derivatives=True, vertices=X)
     N = np.cross(Du, Dv)
     d = pts - Q

@@ -17,7 +17,7 @@ CHUNK = 20000
 
 def _default_depth(scheme: str) -> int:
     # Chart size after the descent: 3^(-depth/2) for √3 faces, 2^(-depth) for Loop faces.
-    return 16 if scheme == "loop" else 22
+    return {"loop": 14, "sqrt3": 18}.get(scheme, 24)
 
 
 class LimitSurface:
@@ -32,8 +32,9 @@ class LimitSurface:
     sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
         As for :func:`hybridsub.refine`; every scheme and tag.
     depth : int, optional
-        Levels of exact local refinement before the last interpolation (default 22 for
-        ``"hybrid"`` and ``"sqrt3"``, 16 for ``"loop"``; see ``docs/limit.md``).
+        Levels of exact local refinement before the last interpolation (default 24 for
+        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``: 1e-12 × the diagonal or better,
+        see ``docs/limit.md``).
 
     Notes
     -----
@@ -106,13 +107,13 @@ class LimitSurface:
         b = np.clip(b, 0.0, None)
         return f, b / b.sum(axis=1, keepdims=True)
 
-    def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool):
+    def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         inp = self._inp
         faces0, qn = np.unique(f, return_inverse=True)
         p, sel0 = D.start(inp, faces0)
         maps = [sel0]
         qn, bb = qn.ravel(), b
-        for k in range(self.depth):
+        for k in range(depth):
             p, A, qn, bb = D.step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
             maps.append(A)
         ids, w, wu, wv = D.stencil(p, qn, bb)
@@ -156,10 +157,12 @@ class LimitSurface:
         >>> M.shape, bool(np.allclose(M.sum(axis=1), 1))
         ((2, 4), True)
         """
-        f, b = self._points(face, bary)
+        return self._matrix(*self._points(face, bary), derivatives, self.depth)
+
+    def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         parts = [[] for _ in range(3 if derivatives else 1)]
         for i in range(0, len(f), CHUNK):
-            for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives)):
+            for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
                 acc.append(R)
         n = self._inp.n_vertices
         mats = [sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
@@ -222,7 +225,7 @@ class LimitSurface:
         >>> import numpy as np, hybridsub
         >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
         >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-        >>> s = hybridsub.LimitSurface(V, F)
+        >>> s = hybridsub.LimitSurface(V, F, depth=12)
         >>> P = s.evaluate([3], [[0.3, 0.3, 0.4]]); N = s.normals([3], [[0.3, 0.3, 0.4]])
         >>> face, bary, Q, dist = s.project(P + 0.01 * N)
         >>> bool(np.allclose(Q, P, atol=1e-12)), bool(np.isclose(dist[0], 0.01, atol=1e-12))
