@@ -28,14 +28,14 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr_
     from ._app.interop import subdivide_mesh
     from ._input import Features, detect_features
     from ._io import TaggedMesh, load_example, read_mesh, write_mesh
-    from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, limit_matrix,
-                           limit_normals, limit_positions, refine, refine_face_varying, seam_edges,
+    from ._refiner import (FaceVaryingRefinement, LimitSurface, Refinement, RefinementStep, get_memory_limit,
+                           limit_matrix, limit_normals, limit_positions, refine, refine_face_varying, seam_edges,
                            set_memory_limit, subdivide, subdivide_face_varying)
 
 #: Where each public name lives (imported when first used).
 _HOMES = {
-    "._refiner": ("FaceVaryingRefinement", "Refinement", "RefinementStep", "get_memory_limit", "limit_matrix",
-                  "limit_normals", "limit_positions", "refine", "refine_face_varying", "seam_edges",
+    "._refiner": ("FaceVaryingRefinement", "LimitSurface", "Refinement", "RefinementStep", "get_memory_limit",
+                  "limit_matrix", "limit_normals", "limit_positions", "refine", "refine_face_varying", "seam_edges",
                   "set_memory_limit", "subdivide", "subdivide_face_varying"),
     "._input": ("Features", "detect_features"),
     "._io": ("TaggedMesh", "load_example", "read_mesh", "write_mesh"),
@@ -49,8 +49,8 @@ __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
-    "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
-    "batch", "BatchSummary",
+    "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "LimitSurface",
+    "analysis", "batch", "BatchSummary",
 ]
 
 
