@@ -19,7 +19,7 @@ from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, 
 from .budget import Budget, check_product
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
-from .stencils import apply_matrix, step_matrix
+from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, step_matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,8 +139,11 @@ class Refinement:
 
         Floating-point data keeps its dtype (computed in float64); other data comes back as
         float64; complex data stays complex. The result is always a new array, also with no
-        steps. The step matrices are applied one after the other, which is cheaper than the
-        composite when the matrix has not been formed.
+        steps. Once ``matrix`` has been formed, ``apply`` multiplies by it (one pass over the
+        data, the product ``matrix @ X`` to the bit); before, by the step matrices one after the
+        other (``subdivide``'s result to the bit). Either is held with its distinct weights
+        stored once (a 2-byte code an entry, see ``docs/performance.md``), built on the first
+        call; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
 
         Examples
         --------
@@ -156,15 +159,21 @@ class Refinement:
             Y = np.concatenate([Y.real, Y.imag], axis=1)
         if not self.steps:
             Y = Y.copy()
-        elif "matrix" in self._cache:
-            Y = apply_matrix(self._cache["matrix"], Y)
-        else:
-            for st in self.steps:
-                Y = apply_matrix(st.matrix, Y)
+        for S in self._stencils():
+            Y = apply_coded(S, Y) if isinstance(S, CodedStencils) else apply_matrix(S, Y)
         if work == np.complex128:
             k = Y.shape[1] // 2
             Y = Y[:, :k] + 1j * Y[:, k:]
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
+
+    def _stencils(self) -> list:
+        """What :meth:`apply` multiplies by, coded where the weights allow: the composite once
+        formed, else the steps. Built once each."""
+        key = "coded matrix" if "matrix" in self._cache else "coded steps"
+        if key not in self._cache:
+            mats = [self._cache["matrix"]] if key == "coded matrix" else [st.matrix for st in self.steps]
+            self._cache[key] = [coded_stencils(S) or S for S in mats]
+        return self._cache[key]
 
 
 def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *, n_vertices: int | None = None,
