@@ -50,10 +50,11 @@ def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:
     return out
 
 
-def apply_matrix(S: sp.csr_matrix, X: np.ndarray) -> np.ndarray:
-    """``S @ X`` for (n, k) float64 data, rows in parallel; the same bits as SciPy's product."""
+def apply_matrix(S: sp.csr_matrix, X: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``S @ X`` for (n, k) float64 data, rows in parallel; the same bits as SciPy's product.
+    ``out``: a C-contiguous (S.shape[0], k) float64 array to write it into."""
     X = np.ascontiguousarray(X, dtype=np.float64)
-    out = np.empty((S.shape[0], X.shape[1]), np.float64)
+    out = np.empty((S.shape[0], X.shape[1]), np.float64) if out is None else out
     kernel = K.csr_apply if use_threads(S.shape[0]) else K.csr_apply_serial
     kernel(S.indptr, S.indices, S.data, X, out)
     return out
@@ -95,10 +96,11 @@ def coded_stencils(S: sp.csr_matrix) -> CodedStencils | None:
     return CodedStencils(S.indptr, indices, codes, table[:n].view(np.float64).copy(), S.shape)
 
 
-def apply_coded(C: CodedStencils, X: np.ndarray) -> np.ndarray:
-    """``S @ X`` for (n, k) float64 data, bit for bit as :func:`apply_matrix` with S."""
+def apply_coded(C: CodedStencils, X: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``S @ X`` for (n, k) float64 data, bit for bit as :func:`apply_matrix` with S (``out``
+    likewise)."""
     X = np.ascontiguousarray(X, dtype=np.float64)
-    out = np.empty((C.shape[0], X.shape[1]), np.float64)
+    out = np.empty((C.shape[0], X.shape[1]), np.float64) if out is None else out
     threaded = use_threads(C.shape[0])
     if X.shape[1] == 3:
         kernel = K.coded_apply3 if threaded else K.coded_apply3_serial
