@@ -14,7 +14,7 @@
 //                 (default: OpenMP's default)
 // stencils_cpu, update_cpu, update_double_cpu: the same sections in process CPU time (serial
 // sections: the time this process held a core, whatever else ran on the machine).
-// Prints one JSON object; --out writes the double table's result with the last level's faces.
+// Prints one JSON object; --out writes the float table's frame with the last level's faces.
 #include <omp.h>
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
@@ -132,7 +132,7 @@ int main(int argc, char** argv) try {
         if (rows != nv) throw std::runtime_error("stencil count differs from the last level's vertex count");
         if (r == warmup + repeat - 1 && !args.get("out").empty()) {
             harness::Mesh out;
-            out.V.assign(&dst_d[0].p[0], &dst_d[0].p[0] + 3 * size_t(rows));
+            out.V.assign(&dst_f[0].p[0], &dst_f[0].p[0] + 3 * size_t(rows));  // the float table's frame
             for (int f = 0; f < nf; ++f) {
                 Far::ConstIndexArray fv = last.GetFaceVertices(f);
                 out.F.insert(out.F.end(), {fv[0], fv[1], fv[2]});
