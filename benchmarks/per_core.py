@@ -119,8 +119,9 @@ def check_stencils(levels: int = 2) -> str:
     return f"{'agrees' if ok else '**differs**'}: same counts {same}, max distance {float(dmax):.1e} × diagonal (L{levels})"
 
 
-def collect(rounds: int, repeat: int, levels: int, log=print) -> dict:
-    """Every contender, ``rounds`` times interleaved; {key: {"wall": [...], "cpu": [...]}}."""
+def collect(rounds: int, repeat: int, levels: int, log=print, save=None) -> dict:
+    """Every contender, ``rounds`` times interleaved; {key: {"wall": [...], "cpu": [...]}}.
+    ``save(T)`` is called after every round (what a long run has gathered so far)."""
     arm = load("armadillo")
     cores = os.cpu_count() or 1
     T: dict = {}
@@ -150,7 +151,9 @@ def collect(rounds: int, repeat: int, levels: int, log=print) -> dict:
         add("osd loop t1", loop["subdivide"]["times"])
         cgal = harness("cgal_subdiv", [arm.path, "sqrt3", str(levels), "--repeat", str(repeat)])
         add("cgal sqrt3 t1", cgal["subdivide"]["times"])
-    T["cores"] = cores
+        T["cores"] = cores
+        if save:
+            save(T)
     return T
 
 
@@ -238,15 +241,18 @@ def main(argv=None) -> int:
         return 2
     log = lambda s: print(s, file=sys.stderr, flush=True)  # noqa: E731
     check = check_stencils()
-    T = collect(args.rounds, args.repeat, args.levels, log)
+    def save(T):
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(T, fh, indent=1)
+
+    T = collect(args.rounds, args.repeat, args.levels, log, save)
     md = "\n".join(report(T, check, args.levels)) + "\n"
     print(md)
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write(md)
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(T, fh, indent=1)
+    save(T)
     return 0
 
 

@@ -12,6 +12,7 @@ True
 """
 
 from ._errors import MeshError, OutputTooLargeError
+from ._jit import set_threads
 from ._input import Features, detect_features
 from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, limit_matrix,
                        limit_normals, limit_positions, refine, refine_face_varying, seam_edges, set_memory_limit,
@@ -26,6 +27,6 @@ __all__ = [
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
-    "batch", "BatchSummary",
+    "batch", "BatchSummary", "set_threads",
 ]
 from ._version import __version__ as __version__

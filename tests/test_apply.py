@@ -6,6 +6,7 @@ import pytest
 import scipy.sparse as sp
 
 import hybridsub
+from hybridsub._io import example_path
 from hybridsub._refiner import stencils as _stencils
 from hybridsub._topology import _kernels as _topo_kernels
 
@@ -109,3 +110,33 @@ def test_apply_into_a_buffer():
     r0 = hybridsub.refine(F, levels=0)
     X = np.eye(3)
     assert np.array_equal(r0.apply(X, out=np.empty((3, 3))), X)
+
+
+def test_one_thread_and_all_give_the_same_bits(monkeypatch, tmp_path):
+    monkeypatch.setattr(_topo_kernels, "PARALLEL_MIN", 0)  # every kernel on its threaded twin
+    V, F = hybridsub.load_example()
+    feat = hybridsub.detect_features(V, F)
+    try:
+        assert hybridsub.set_threads(1) == 1
+        one = hybridsub.subdivide(V, F, feat.sharp_edges, levels=2, corners=feat.corners)
+        r1 = hybridsub.refine(F, feat.sharp_edges, 2, corners=feat.corners)
+        a1 = r1.apply(V), r1.matrix, r1.apply(V)
+        hybridsub.set_threads(None)
+        every = hybridsub.subdivide(V, F, feat.sharp_edges, levels=2, corners=feat.corners)
+        r2 = hybridsub.refine(F, feat.sharp_edges, 2, corners=feat.corners)
+        a2 = r2.apply(V), r2.matrix, r2.apply(V)
+    finally:
+        hybridsub.set_threads(None)
+    assert all(np.array_equal(x, y) for x, y in zip(one, every))
+    assert np.array_equal(a1[0], a2[0]) and np.array_equal(a1[2], a2[2]) and (a1[1] != a2[1]).nnz == 0
+    with pytest.raises(ValueError, match="between 1 and"):
+        hybridsub.set_threads(0)
+    with pytest.raises(TypeError):
+        hybridsub.set_threads(1.5)
+    from hybridsub._app.cli import main
+    out = tmp_path / "o.off"
+    assert main(["--threads", "1", "subdivide", str(example_path("fandisk")), "-o", str(out),
+                 "--levels", "1", "-q"]) == 0
+    import numba
+    assert numba.get_num_threads() == 1
+    hybridsub.set_threads(None)

@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import _io
 from .._errors import MeshError
+from .._jit import set_threads
 from .._input import SCHEMES, count_of, detect_features
 from .._io import example_path
 from .._units import short_bytes
@@ -319,6 +320,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 success, 1 the input or the run failed, 2 bad command line. "
                "See docs/usage.md and docs/formats.md.")
     ap.add_argument("--version", action="version", version=f"hybridsub {__version__}")
+    ap.add_argument("--threads", type=_positive, metavar="N",
+                    help="threads for the kernels (default: every core); the output does not depend on it")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo):
         add(sub)
@@ -416,6 +419,8 @@ def main(argv=None) -> int:
     ap = build_parser()
     a = ap.parse_args(argv)
     try:
+        if a.threads is not None:
+            set_threads(a.threads)
         return a.func(a)
     except PipelineError as e:
         msg = str(e)
