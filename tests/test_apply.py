@@ -6,7 +6,6 @@ import pytest
 import scipy.sparse as sp
 
 import hybridsub
-from hybridsub._io import example_path
 from hybridsub._refiner import stencils as _stencils
 from hybridsub._topology import _kernels as _topo_kernels
 
@@ -134,9 +133,10 @@ def test_one_thread_and_all_give_the_same_bits(monkeypatch, tmp_path):
     with pytest.raises(TypeError):
         hybridsub.set_threads(1.5)
     from hybridsub._app.cli import main
-    out = tmp_path / "o.off"
-    assert main(["--threads", "1", "subdivide", str(example_path("fandisk")), "-o", str(out),
-                 "--levels", "1", "-q"]) == 0
+    src, out = tmp_path / "tet.off", tmp_path / "o.off"
+    src.write_text("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    assert main(["--threads", "1", "subdivide", str(src), "-o", str(out), "--levels", "1", "-q"]) == 0
+    assert out.exists()
     import numba
     assert numba.get_num_threads() == 1
     hybridsub.set_threads(None)
