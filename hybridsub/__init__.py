@@ -13,7 +13,7 @@ True
 
 from ._errors import MeshError, OutputTooLargeError
 from ._input import Features, detect_features
-from ._refiner import (FaceVaryingRefinement, MultiresDetails, Refinement, RefinementStep, get_memory_limit, limit_matrix,
+from ._refiner import (FaceVaryingRefinement, FitResult, MultiresDetails, fit, Refinement, RefinementStep, get_memory_limit, limit_matrix,
                        limit_normals, limit_positions, refine, refine_face_varying, seam_edges, set_memory_limit,
                        subdivide, subdivide_face_varying)
 from ._io import TaggedMesh, load_example, read_mesh, write_mesh
@@ -26,6 +26,6 @@ __all__ = [
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "analysis",
-    "batch", "BatchSummary", "MultiresDetails",
+    "batch", "BatchSummary", "MultiresDetails", "fit", "FitResult",
 ]
 from ._version import __version__ as __version__
