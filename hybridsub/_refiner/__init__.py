@@ -5,12 +5,13 @@ Other layers import from here, never from the modules inside."""
 from .budget import get_memory_limit, physical_memory, predict_levels, set_memory_limit
 from .facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from .fastpath import LevelOutput, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data
-from .limit import limit_matrix, limit_normals, limit_positions
 from .fitting import FitResult, fit
+from .limit import LimitSurface, limit_matrix, limit_normals, limit_positions
 from .multires import MultiresDetails
 from .refinement import Refinement, RefinementStep, refine, refinement_of
 
-__all__ = ["FaceVaryingRefinement", "FitResult", "LevelOutput", "fit", "MultiresDetails", "Refinement", "RefinementStep", "get_memory_limit",
+__all__ = ["FaceVaryingRefinement", "FitResult", "LevelOutput", "LimitSurface", "MultiresDetails", "Refinement",
+           "RefinementStep", "fit", "get_memory_limit",
            "limit_matrix", "limit_normals", "limit_positions", "physical_memory", "predict_levels", "refine",
            "refine_face_varying", "refinement_of", "seam_edges", "set_memory_limit", "subdivide",
            "subdivide_face_varying", "subdivide_face_varying_levels", "subdivide_levels", "walk_data"]

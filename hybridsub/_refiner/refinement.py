@@ -14,9 +14,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._input import RefineInput, as_data, open_gate
-from .._topology import child_creases, face_parents
+from .._topology import build_level, child_creases, face_parents
 from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .budget import Budget, check_product
+from .chart import vertex_origins
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
 from .multires import MultiresDetails, decompose, reconstruct
@@ -107,6 +108,7 @@ class Refinement:
     n_coarse: int
     max_memory: MemoryLimit = field(default=None, repr=False)  # the limit forming ``matrix`` honours
     uv_refinement: Refinement | None = field(default=None, repr=False)  # the UV index mesh's, with uv_faces
+    coarse_faces: np.ndarray | None = field(default=None, repr=False)  # the input's faces (for vertex_origin)
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -134,6 +136,35 @@ class Refinement:
             S.sort_indices()
             self._cache["matrix"] = S
         return self._cache["matrix"]
+
+    @property
+    def vertex_origin(self) -> tuple[np.ndarray, np.ndarray]:
+        """Where each vertex of the finest level lies over the input: ``(face, bary)``.
+
+        ``face`` (n_L,) int64 is an input face containing the vertex's parameter and ``bary``
+        (n_L, 3) its barycentric coordinates over ``F[face]``, in the chart where the two faces
+        of every edge form a rhombus of equilateral triangles: old vertices keep their place,
+        edge points sit at midpoints (Kobbelt's boundary trisection at thirds), face points at
+        centroids. A vertex on several input faces is reported on the one its first face (in
+        face order) descends from. ``hybridsub.LimitSurface(...).evaluate(*r.vertex_origin)``
+        equals ``hybridsub.limit_positions(..., levels=L)``. Vertices no face uses: face −1.
+        Not available after ``non_manifold="cut"`` (``ValueError``).
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> r = hybridsub.refine(np.array([[0, 1, 2]]), levels=1, scheme="loop")
+        >>> face, bary = r.vertex_origin
+        >>> face.tolist(), bary[3:].round(3).tolist()          # the three edge midpoints
+        ([0, 0, 0, 0, 0, 0], [[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]])
+        """
+        if "origin" not in self._cache:
+            if self.coarse_faces is None:
+                raise ValueError('vertex_origin is not available for a refinement with non_manifold="cut"')
+            self._cache["origin"] = vertex_origins(self.coarse_faces, self.n_coarse, self.steps,
+                                                   lambda F, n: build_level(F, n).twin)
+        face, bary = self._cache["origin"]
+        return face.copy(), bary.copy()
 
     def apply(self, X: ArrayLike) -> np.ndarray:
         """Refine per-vertex data: positions, UVs, colours, any (n_coarse, ...) array.
@@ -334,7 +365,8 @@ def refinement_of(inp: RefineInput) -> Refinement:
         uv = Refinement(uv_faces, uv_pairs, uv_sharp, mask, uv_corners, face_parent.copy(), uv_steps,
                         inp.uv.n_uvs, inp.max_memory)
     faces = steps[-1].faces if steps else inp.faces.copy()
-    r = Refinement(faces, pairs, sharp, mask, corners, face_parent, steps, inp.n_vertices, inp.max_memory, uv)
+    r = Refinement(faces, pairs, sharp, mask, corners, face_parent, steps, inp.n_vertices, inp.max_memory, uv,
+                   coarse_faces=inp.faces if inp.cut is None else None)
     return _compose_cut(inp, r)
 
 
@@ -364,7 +396,8 @@ def _unrefined(inp: RefineInput) -> Refinement:
                             None if uv is None else sp.identity(inp.uv.n_uvs, format="csr"))
              for _ in range(levels)]
     faces = steps[-1].faces if steps else inp.faces.copy()
-    return Refinement(faces, inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n, inp.max_memory, uv)
+    return Refinement(faces, inp.sharp_edges, inp.sharpness, mask, corners, ident, steps, n, inp.max_memory, uv,
+                      coarse_faces=inp.faces if inp.cut is None else None)
 
 
 def _compose_cut(inp: RefineInput, r: Refinement) -> Refinement:

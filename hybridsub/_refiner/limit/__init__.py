@@ -4,9 +4,12 @@
 of a level, on the sectors the topology layer cuts (``_topology.vertex_sectors``);
 ``normals`` turns tangent masks and control fans into sector normals; ``local`` refines the
 stars of the vertices without a stationary mask until their rows and normals settle; ``api``
-holds the public functions. ``docs/limit.md`` explains every decision taken here.
+holds the public functions. ``descent`` follows any point of the surface down the refinement
+(exact local refinement), ``surface`` is :class:`LimitSurface` on top of it, ``project`` its
+closest points. ``docs/limit.md`` explains every decision taken here.
 """
 
 from .api import limit_matrix, limit_normals, limit_positions
+from .surface import LimitSurface
 
-__all__ = ["limit_matrix", "limit_normals", "limit_positions"]
+__all__ = ["LimitSurface", "limit_matrix", "limit_normals", "limit_positions"]

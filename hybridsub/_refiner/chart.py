@@ -1,0 +1,243 @@
+"""The parameter chart: where every refined vertex lies over the input.
+
+Every input face is an equilateral triangle of the chart, and the two faces of an edge form a
+rhombus. A step keeps the old vertices where they are, puts edge points at the midpoints of
+their edges (Kobbelt's boundary trisection points at the thirds), face points at the centroids
+of their faces. The chart is flat away from the input vertices, so the shape of each refined
+face — its three corners in a 2-D frame of its own — is all a step needs: a child face's
+corners are found in its parent's frame, those of a neighbour face's points after gluing the
+neighbour onto the parent along their shared edge (a rigid motion of the chart).
+
+>>> import numpy as np
+>>> F = np.array([[0, 1, 2], [2, 1, 3]]); shape = np.repeat(EQUILATERAL[None], 2, axis=0)
+>>> twin = np.array([-1, 3, -1, 1, -1, -1])
+>>> glued = glue(shape, twin, F)           # face 1 seen from face 0, across edge 1 → 2
+>>> np.round(glued[0, 1, 2], 6).tolist()   # face 1's third vertex: the rhombus's far corner
+[1.5, 0.866025]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+#: The input faces' corners in their own frames: equilateral, unit sides.
+EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
+
+
+def barycentric(tri: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates of points ``x`` (..., 2) in triangles ``tri`` (..., 3, 2)."""
+    a, b, c = tri[..., 0, :], tri[..., 1, :], tri[..., 2, :]
+    e1, e2, d = b - a, c - a, x - a
+    det = e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0]
+    u = (d[..., 0] * e2[..., 1] - d[..., 1] * e2[..., 0]) / det
+    v = (e1[..., 0] * d[..., 1] - e1[..., 1] * d[..., 0]) / det
+    return np.stack([1.0 - u - v, u, v], axis=-1)
+
+
+def rigid(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray):
+    """The rotation R (..., 2, 2) and translation t (..., 2) taking segment p0p1 onto q0q1."""
+    dp, dq = p1 - p0, q1 - q0
+    ap = np.arctan2(dp[..., 1], dp[..., 0])
+    aq = np.arctan2(dq[..., 1], dq[..., 0])
+    c, s = np.cos(aq - ap), np.sin(aq - ap)
+    R = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+    t = q0 - np.einsum("...ij,...j->...i", R, p0)
+    return R, t
+
+
+def glue_maps(shape: np.ndarray, twin: np.ndarray, faces_at: np.ndarray):
+    """For faces ``faces_at`` (k,), the rigid map of each edge-neighbour's frame onto theirs.
+
+    Returns ``nbr`` (k, 3) the neighbour across halfedge i (−1 on the boundary) and ``R``
+    (k, 3, 2, 2), ``t`` (k, 3, 2): ``x_here = R @ x_there + t``.
+    """
+    h = 3 * faces_at[:, None] + np.arange(3)
+    tw = twin[h]
+    nbr = np.where(tw >= 0, tw // 3, -1)
+    j = np.where(tw >= 0, tw % 3, 0)
+    g = np.maximum(nbr, 0)
+    here = shape[faces_at]  # (k, 3, 2)
+    u_here, w_here = here, np.roll(here, -1, axis=1)  # halfedge i runs corner i → i + 1
+    # The neighbour's halfedge j runs w → u.
+    w_there = shape[g, j]
+    u_there = shape[g, (j + 1) % 3]
+    R, t = rigid(u_there, w_there, u_here, w_here)
+    return nbr, R, t
+
+
+def glue(shape: np.ndarray, twin: np.ndarray, F: np.ndarray, faces_at: np.ndarray | None = None) -> np.ndarray:
+    """Corners (k, 3, 3, 2) of each face's three edge-neighbours, in that face's frame (NaN on the boundary)."""
+    faces_at = np.arange(len(F)) if faces_at is None else faces_at
+    nbr, R, t = glue_maps(shape, twin, faces_at)
+    out = np.einsum("kiab,kicb->kica", R, shape[np.maximum(nbr, 0)]) + t[:, :, None, :]
+    out[nbr < 0] = np.nan
+    return out
+
+
+def plan_supports(F: np.ndarray, plan, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Chart weights of every vertex of the next level over this level's: (n', 3) ids, (n', 3) weights.
+
+    Old vertices keep their place, edge points sit at midpoints (Kobbelt's trisection points
+    at the thirds), face points at centroids. Unused slots have id −1 and weight 0.
+    """
+    n1 = plan.n_new
+    ids = np.full((n1, 3), -1, np.int64)
+    w = np.zeros((n1, 3))
+    ids[:n, 0] = np.arange(n)
+    w[:n, 0] = 1.0
+    fv = F.ravel()
+    h = np.flatnonzero(plan.edge_point >= 0)
+    nxt = 3 * (h // 3) + (h % 3 + 1) % 3
+    e = plan.edge_point[h]
+    tri = plan.trisected[h // 3] == h % 3
+    ids[e, 0], ids[e, 1] = fv[h], fv[nxt]
+    w[e, 0] = np.where(tri, 2.0 / 3.0, 0.5)
+    w[e, 1] = np.where(tri, 1.0 / 3.0, 0.5)
+    ht = h[tri]
+    e2 = plan.edge_point[ht] + 1
+    ids[e2, 0], ids[e2, 1] = fv[ht], fv[nxt[tri]]
+    w[e2, 0], w[e2, 1] = 1.0 / 3.0, 2.0 / 3.0
+    f = np.flatnonzero(plan.face_point >= 0)
+    ids[plan.face_point[f]] = F[f]
+    w[plan.face_point[f]] = 1.0 / 3.0
+    return ids, w
+
+
+def matrix_supports(S: sp.csr_matrix, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`plan_supports` read off a step matrix's rows (for a :class:`Refinement`, which keeps no plans).
+
+    A row of three weights 1/3 is a face point; otherwise the two largest weights are the
+    edge's ends: a midpoint if they are equal, else a trisection point (2/3 at the larger).
+    """
+    S = sp.csr_matrix(S)
+    n1 = S.shape[0]
+    ids = np.full((n1, 3), -1, np.int64)
+    w = np.zeros((n1, 3))
+    ids[:n, 0] = np.arange(n)
+    w[:n, 0] = 1.0
+    nnz = np.diff(S.indptr)[n:]
+    rows = np.arange(n, n1)
+    if not len(nnz):
+        return ids, w
+    width = max(int(nnz.max()), 3)
+    pad_i = np.full((len(rows), width), -1, np.int64)
+    pad_w = np.full((len(rows), width), -1.0)
+    r = np.repeat(np.arange(len(rows)), nnz)
+    col = np.arange(len(r)) - np.repeat(S.indptr[n:-1] - S.indptr[n], nnz)
+    pad_i[r, col] = S.indices[S.indptr[n]:]
+    pad_w[r, col] = S.data[S.indptr[n]:]
+    order = np.argsort(-pad_w, axis=1, kind="stable")
+    pi = np.take_along_axis(pad_i, order, 1)
+    pw = np.take_along_axis(pad_w, order, 1)
+    face = (nnz == 3) & np.all(np.abs(pad_w[:, :3] - 1.0 / 3.0) < 1e-12, axis=1)
+    ids[rows, 0], ids[rows, 1] = pi[:, 0], pi[:, 1]
+    same = np.abs(pw[:, 0] - pw[:, 1]) < 1e-9
+    w[rows, 0] = np.where(same, 0.5, 2.0 / 3.0)
+    w[rows, 1] = np.where(same, 0.5, 1.0 / 3.0)
+    fr = rows[face]
+    ids[fr] = pad_i[face, :3]
+    w[fr] = 1.0 / 3.0
+    return ids, w
+
+
+def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.ndarray, parent: np.ndarray,
+                 sup_ids: np.ndarray, sup_w: np.ndarray) -> np.ndarray:
+    """Each child face's corners (m', 3, 2) in its parent's frame.
+
+    ``faces1`` and ``parent`` may be any subset of the next level's faces. A child's corner is
+    a chart combination of the corners of one face: its parent, or one of the parent's
+    edge-neighbours glued onto it (a neighbour's face point, Kobbelt's apexes). The first
+    of those four faces that holds every support is used: around a vertex of low valence the
+    chart is not flat, and the same vertex glued through two neighbours lies in two places.
+    """
+    parents, pi = np.unique(parent, return_inverse=True)
+    nb = np.nan_to_num(glue(shape, twin, F, parents))  # (p, 3, 3, 2): neighbour i's corners, parent frame
+    tw = twin[3 * parents[:, None] + np.arange(3)]
+    g = np.where(tw >= 0, tw // 3, 0)
+    nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
+    group_ids = np.concatenate([F[parents][:, None], nb_ids], axis=1)[pi]  # (m', 4, 3)
+    group_pos = np.concatenate([shape[parents][:, None], nb], axis=1)[pi]  # (m', 4, 3, 2)
+    ids = sup_ids[faces1]  # (m', 3 corners, 3 supports)
+    ws = sup_w[faces1]
+    match = ids[:, :, :, None, None] == group_ids[:, None, None]  # (m', 3, 3, 4, 3)
+    holds = (match.any(-1) | (ids < 0)[..., None]).all(axis=2)  # (m', 3, 4): group holds every support
+    if not holds.any(-1).all():  # pragma: no cover - the emission patterns guarantee it
+        raise AssertionError("a child corner is not a combination of its parent's neighbourhood")
+    grp = holds.argmax(-1)  # (m', 3)
+    k = np.arange(len(faces1))
+    which = np.take_along_axis(match, grp[:, :, None, None, None], axis=3)[:, :, :, 0].argmax(-1)  # (m', 3, 3)
+    pos = group_pos[k[:, None, None], grp[:, :, None], which]  # (m', 3, 3, 2)
+    return (ws[..., None] * pos).sum(axis=2)
+
+
+def _across(face, bary, twin0, tol):
+    """One reflection: points with a coordinate below ``-tol`` expressed over the face across
+    the edge opposite that corner (the rhombus's other triangle); boundary points stay."""
+    j = np.argmin(bary, axis=1)
+    out = bary[np.arange(len(bary)), j] < -tol
+    t = twin0[3 * face[out] + (j[out] + 1) % 3]
+    ok = t >= 0
+    idx = np.flatnonzero(out)[ok]
+    t, jj = t[ok], j[out][ok]
+    b = bary[idx]
+    r = np.arange(len(idx))
+    bj, bj1, bj2 = b[r, jj], b[r, (jj + 1) % 3], b[r, (jj + 2) % 3]
+    nb = np.empty_like(b)
+    a = t % 3  # the face across: its corner a is our corner j + 2, a + 1 is j + 1, a + 2 the far one
+    nb[r, a], nb[r, (a + 1) % 3], nb[r, (a + 2) % 3] = bj2 + bj, bj1 + bj, -bj
+    face[idx], bary[idx] = t // 3, nb
+    return len(idx) > 0
+
+
+def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: np.ndarray, max_faces: int = 8):
+    """Points given in an input face's unfolded chart moved onto an input face that contains them.
+
+    A point with a negative coordinate lies across the edge opposite that corner: it is
+    expressed over the face across, and again from there (a point near a vertex may be
+    several faces round it), at most ``max_faces`` times; at the boundary it is clamped onto
+    the face. Tiny negatives are rounding.
+    """
+    face, bary = face.copy(), bary.copy()
+    for _ in range(max_faces):
+        if not _across(face, bary, twin0, 1e-12):
+            break
+    bary = np.clip(bary, 0.0, None)
+    return face, bary / bary.sum(axis=1, keepdims=True)
+
+
+def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray, np.ndarray]:
+    """(face, bary) of every vertex of the last of ``steps`` over the input faces ``F0``.
+
+    ``steps`` are :class:`RefinementStep` objects (faces, matrix, face_parent); ``twin_of(F, n)``
+    gives a level's halfedge twins. Each vertex is reported on the first face (in face order)
+    of the finest level that uses it; a vertex no face uses gets face −1 and bary (1, 0, 0).
+    """
+    F, n = F0, n0
+    shape = np.repeat(EQUILATERAL[None], len(F0), axis=0)
+    B = np.repeat(np.eye(3)[None], len(F0), axis=0)  # corners over the input face, its rhombus chart
+    inface = np.arange(len(F0))
+    twin0 = twin_of(F0, n0)
+    twin = twin0
+    for st in steps:
+        ids, w = matrix_supports(st.matrix, n)
+        parent = st.face_parent
+        shape1 = child_shapes(F, twin, shape, st.faces, parent, ids, w)
+        lam = barycentric(shape[parent][:, None], shape1)
+        B = lam @ B[parent]
+        inface = inface[parent]
+        shape, F, n = shape1, st.faces, st.n_vertices
+        twin = twin_of(F, n)
+    flat = F.ravel()
+    first = np.full(n, -1, np.int64)
+    order = np.arange(len(flat))[::-1]
+    first[flat[order]] = order  # the lowest corner index wins
+    face = np.full(n, -1, np.int64)
+    bary = np.zeros((n, 3))
+    bary[:, 0] = 1.0
+    used = first >= 0
+    face[used] = inface[first[used] // 3]
+    bary[used] = B[first[used] // 3, first[used] % 3]
+    if used.any():
+        face[used], bary[used] = onto_input_faces(face[used], bary[used], twin0, F0)
+    return face, bary

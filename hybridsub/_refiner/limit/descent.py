@@ -1,0 +1,237 @@
+"""Exact local refinement down to any point of the limit surface.
+
+A point (face, bary) is followed through the refinement: at every level only the patch of
+faces around the face that holds it (two vertex rings) is refined, with the project's own
+step (``plan_step``, ``step_matrix``, ``child_level``: every scheme and tag), and the child
+face holding the point is found in the parameter chart (:mod:`.._refiner.chart`). The
+patches of all points are one mesh of disjoint pieces, refined together; points in the same
+patch share it. Each level records the sparse map from one level's patch vertices to the
+next's, so the result is a row over the control vertices: positions enter linearly.
+
+At the last level the point's value is interpolated from the exact limit positions
+(``_rules.limit`` masks, or local refinement where a vertex has none) of six vertices around
+it: the corners of its face and the far corners of the three faces across its edges
+(quadratic Lagrange interpolation in the chart; linear on the boundary). ``docs/limit.md``
+gives the accuracy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..._input import RefineInput
+from ..._topology import Level, child_level, face_parents, plan_step
+from ..chart import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports
+from ..stencils import step_matrix
+from .local import refine_locally
+from .plan import plan_level
+
+#: Vertex rings of faces around a point's face kept at every level.
+RINGS = 2
+#: Interpolation stencils worse conditioned than this fall back to linear interpolation.
+MAX_CONDITION = 1e6
+#: Children of one face at most (√3: 3 + split edges; Loop: 4).
+MAX_CHILDREN = 6
+
+
+@dataclass(frozen=True, eq=False)
+class Patches:
+    """All live patches of one level as one mesh of disjoint pieces."""
+
+    level: Level
+    corner: np.ndarray  # (n,) bool
+    shape: np.ndarray  # (m, 3, 2) every face's corners in its own chart frame
+    face: np.ndarray  # (k,) the face holding each node's points
+    uv: np.ndarray  # (k, 3, 2) that face's corners in the input face's (u, v)
+
+
+def _expand(node: np.ndarray, x: np.ndarray, ptr: np.ndarray, items: np.ndarray, size: int):
+    """(node, item) pairs for every item listed under each (node, x), without repeats, sorted."""
+    cnt = ptr[x + 1] - ptr[x]
+    nn = np.repeat(node, cnt)
+    start = np.repeat(ptr[x] - np.cumsum(cnt) + cnt, cnt)
+    it = items[start + np.arange(len(nn))]
+    key = np.unique(nn * size + it)
+    return key // size, key % size
+
+
+def ring_faces(F: np.ndarray, n: int, centre: np.ndarray, rings: int = RINGS):
+    """(node, face) pairs: the faces within ``rings`` vertex rings of each node's centre face."""
+    m = len(F)
+    flat = F.ravel()
+    order = np.argsort(flat, kind="stable")
+    ptr = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=n))])
+    faces_of = order // 3
+    node = np.repeat(np.arange(len(centre)), 3)
+    v = F[centre].ravel()
+    for r in range(rings):
+        node, f = _expand(node, v, ptr, faces_of, m)
+        if r < rings - 1:
+            key = np.unique(np.repeat(node, 3) * n + F[f].ravel())
+            node, v = key // n, key % n
+    return node, f
+
+
+def cut_patches(level: Level, corner: np.ndarray, node: np.ndarray, f: np.ndarray):
+    """The faces ``f`` of each node as a new mesh of disjoint pieces.
+
+    Returns the new :class:`Level`, its corner mask, the selection (n_new × n) from the old
+    vertices, and the sorted (node, face) keys (to find a face's new index).
+    """
+    n, m = level.n_vertices, level.n_faces
+    Fs = level.faces[f]
+    uniq, inv = np.unique(node[:, None] * n + Fs, return_inverse=True)
+    newF = inv.reshape(-1, 3).astype(np.int64)
+    vsel = uniq % n
+    fkeys = node * m + f
+    tw = level.twin.reshape(-1, 3)[f]
+    k2 = node[:, None] * m + np.where(tw >= 0, tw // 3, 0)
+    pos = np.minimum(np.searchsorted(fkeys, k2), len(fkeys) - 1)
+    ok = (tw >= 0) & (fkeys[pos] == k2)
+    twin = np.where(ok, 3 * pos + tw % 3, -1).ravel()
+    hs = None if level.hsharp is None else level.hsharp.reshape(-1, 3)[f].ravel()
+    new = Level(newF, len(uniq), twin, hs, level.face_sharp[f])
+    sel = sp.csr_matrix((np.ones(len(uniq)), vsel, np.arange(len(uniq) + 1)), shape=(len(uniq), n))
+    return new, corner[vsel], sel, fkeys
+
+
+def start(inp: RefineInput, faces0: np.ndarray):
+    """Level-0 patches around the input faces ``faces0`` (one node each) and their selection."""
+    node, f = ring_faces(inp.level.faces, inp.n_vertices, faces0)
+    level, corner, sel, fkeys = cut_patches(inp.level, inp.corner, node, f)
+    cur = np.searchsorted(fkeys, np.arange(len(faces0)) * inp.n_faces + faces0)
+    shape = np.repeat(EQUILATERAL[None], level.n_faces, axis=0)
+    uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(faces0), axis=0)
+    return Patches(level, corner, shape, cur, uv), sel
+
+
+def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
+    """Children of each node's face and of its edge-neighbours: ids (k, 24) (−1: none) and
+    corners (k, 24, 3, 2) in the node face's frame; ``shapes_of(faces)`` gives child shapes."""
+    nbr, R, t = glue_maps(p.shape, p.level.twin, p.face)
+    k = len(p.face)
+    groups = np.concatenate([p.face[:, None], nbr], axis=1)  # (k, 4)
+    Rg = np.concatenate([np.broadcast_to(np.eye(2), (k, 1, 2, 2)), R], axis=1)
+    tg = np.concatenate([np.zeros((k, 1, 2)), t], axis=1)
+    g = np.maximum(groups, 0)
+    first, cnt = offsets[g], offsets[g + 1] - offsets[g]
+    j = np.arange(MAX_CHILDREN)
+    ids = np.where((groups[..., None] >= 0) & (j < cnt[..., None]), first[..., None] + j, -1)  # (k, 4, 6)
+    some, back = np.unique(np.maximum(ids, 0), return_inverse=True)
+    corners = shapes_of(some)[back.reshape(ids.shape)]  # (k, 4, 6, 3, 2)
+    corners = np.einsum("kgab,kgjcb->kgjca", Rg, corners) + tg[:, :, None, None, :]
+    return ids.reshape(k, -1), corners.reshape(k, -1, 3, 2)
+
+
+def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weights: str, step_no: int):
+    """One level down: refine the patches, follow every point into its child face, cut the
+    next patches. Returns (next Patches, map from this level's vertices, qnode, bary)."""
+    lvl = p.level
+    plan = plan_step(lvl, p.corner, scheme, step_no, loop_weights)
+    S = step_matrix(lvl, plan)
+    faces1, child, offsets = child_level(lvl, plan)
+    ids, w = plan_supports(lvl.faces, plan, lvl.n_vertices)
+    parent = face_parents(offsets)
+
+    def shapes_of(faces):
+        return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
+
+    cid, ccorn = _candidates(p, offsets, shapes_of)
+    x = np.einsum("qc,qcd->qd", bary, p.shape[p.face[qnode]])
+    b = barycentric(ccorn[qnode], x[:, None, :])  # (q, 24, 3)
+    score = np.where(cid[qnode] >= 0, b.min(axis=2), -np.inf)
+    pick = np.argmax(score, axis=1)
+    q = np.arange(len(qnode))
+    chosen = cid[qnode, pick]
+    nb = b[q, pick]
+    key, first, qn = np.unique(qnode * len(faces1) + chosen, return_index=True, return_inverse=True)
+    centre = key % len(faces1)
+    own = ccorn[qnode[first], pick[first]]  # (k', 3, 2) the chosen faces' corners, parent node frame
+    lam = barycentric(p.shape[p.face[qnode[first]]][:, None], own)
+    uv = lam @ p.uv[qnode[first]]
+    corner1 = np.concatenate([p.corner, np.zeros(plan.n_new - lvl.n_vertices, bool)])
+    node, f = ring_faces(faces1, plan.n_new, centre)
+    nxt, corner_n, sel, fkeys = cut_patches(child, corner1, node, f)
+    cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
+    used, back = np.unique(f, return_inverse=True)
+    shape_n = shapes_of(used)[back]
+    return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(sel @ S), qn.ravel(), nb
+
+
+def _edge_tags(level: Level, scheme: str):
+    tagged = np.zeros(level.n_edges) if level.hsharp is None else level.hsharp[level.edge_owner].copy()
+    if scheme == "sqrt3":
+        return tagged, np.where(level.boundary_edge, np.inf, 0.0)
+    return tagged, np.where(level.boundary_edge, np.inf, tagged)
+
+
+def limit_rows(p: Patches, needed: np.ndarray, scheme: str, loop_weights: str, tol: float, max_levels: int):
+    """Limit rows (n × n CSR; only ``needed`` rows filled) of the patches' vertices."""
+    lvl = p.level
+    n = lvl.n_vertices
+    tagged, esharp = _edge_tags(lvl, scheme)
+    plan = plan_level(lvl, esharp, lvl.face_sharp, p.corner, scheme, loop_weights)
+    L = plan.limit_csr(n, only=needed)
+    centers = needed[~plan.pos_ok[needed]]
+    if len(centers):
+        rows, _ = refine_locally(lvl, tagged, lvl.face_sharp, p.corner, scheme, loop_weights, centers, plan, None,
+                                 True, tol, max_levels)
+        moved = sp.csr_matrix((np.ones(len(centers)), (centers, np.arange(len(centers)))), shape=(n, len(centers)))
+        L = L + moved @ rows
+    return sp.csr_matrix(L)
+
+
+def _basis(P):
+    s, u = P[..., 0], P[..., 1]
+    return np.stack([np.ones_like(s), s, u, s * s, s * u, u * u], -1)
+
+
+def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
+    """Interpolation of the last level: vertex ids (q, 6), weights for the value and for ∂/∂u,
+    ∂/∂v (q, 6 each) at every point, from six vertices around it (quadratic in the chart)."""
+    lvl = p.level
+    nbr, R, t = glue_maps(p.shape, lvl.twin, p.face)
+    tw = lvl.twin[3 * p.face[:, None] + np.arange(3)]
+    far_local = np.where(tw >= 0, (tw % 3 + 2) % 3, 0)
+    g = np.maximum(nbr, 0)
+    far_ids = np.where(nbr >= 0, lvl.faces[g, far_local], -1)
+    far = np.einsum("kiab,kib->kia", R, p.shape[g, far_local]) + t
+    here = p.shape[p.face]  # (k, 3, 2)
+    # A normalised frame: the face's centroid at 0, unit size.
+    c0 = here.mean(axis=1, keepdims=True)
+    scale = np.linalg.norm(here[:, 1] - here[:, 0], axis=1)[:, None, None]
+    pts = (np.concatenate([here, far], axis=1) - c0) / scale  # (k, 6, 2)
+    ids = np.concatenate([lvl.faces[p.face], far_ids], axis=1)
+    full = (nbr >= 0).all(axis=1)
+    A = _basis(np.where(full[:, None, None], pts, 0.0))  # (k, 6, 6)
+    A[~full] = np.eye(6)
+    full &= np.linalg.cond(A) < MAX_CONDITION  # slivers (√3 crease sectors grow a face per level)
+    A[~full] = np.eye(6)
+    x = (np.einsum("qc,qcd->qd", bary, here[qnode]) - c0[qnode, 0]) / scale[qnode, 0]
+    s, u = x[:, 0], x[:, 1]
+    z, o = np.zeros_like(s), np.ones_like(s)
+    rhs = np.stack([_basis(x), np.stack([z, o, z, 2 * s, u, z], -1), np.stack([z, z, o, z, s, 2 * u], -1)], -1)
+    W = np.linalg.solve(np.swapaxes(A, 1, 2)[qnode], rhs)  # (q, 6, 3): value, d/ds, d/dt weights
+    lin = ~full[qnode]
+    if lin.any():  # a boundary face or a sliver: linear interpolation
+        W[lin] = 0.0
+        W[lin, :3, 0] = bary[lin]
+        E = here[qnode[lin]] / scale[qnode[lin]]
+        Minv = np.linalg.inv(np.stack([E[:, 1] - E[:, 0], E[:, 2] - E[:, 0]], -1))  # rows: d bary1,2 / d(s,t)
+        W[lin, 1:3, 1:] = Minv
+        W[lin, 0, 1:] = -Minv.sum(axis=1)
+    at = np.flatnonzero(bary.max(axis=1) >= 1.0 - 1e-14)  # at a vertex: its limit position exactly
+    W[at, :, 0] = 0.0
+    W[at, np.argmax(bary[at], axis=1), 0] = 1.0
+    # d/d(u,v) = d/d(s,t) · d(s,t)/d(u,v), the chart frame being affine in (u, v) over the face.
+    X = here[qnode] / scale[qnode]
+    U = p.uv[qnode]
+    Mx = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], -1)  # columns: ∂x/∂(bary1, bary2)
+    Mu = np.stack([U[:, 1] - U[:, 0], U[:, 2] - U[:, 0]], -1)
+    J = Mx @ np.linalg.inv(Mu)  # ∂(s,t)/∂(u,v)
+    Wu = W[:, :, 1] * J[:, None, 0, 0] + W[:, :, 2] * J[:, None, 1, 0]
+    Wv = W[:, :, 1] * J[:, None, 0, 1] + W[:, :, 2] * J[:, None, 1, 1]
+    return ids[qnode], W[:, :, 0], Wu, Wv

@@ -1,0 +1,257 @@
+"""The limit surface anywhere: :class:`LimitSurface`, evaluated at any (face, bary), with
+derivatives, normals and closest points; every value a sparse row over the control vertices."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..._input import as_vertices, open_gate
+from ..._typing import ArrayLike, LoopWeights, Scheme
+from . import descent as D
+from .project import closest_points, seed_setup
+
+#: Points followed down together (bounds the memory of one pass).
+CHUNK = 20000
+
+
+def _default_depth(scheme: str) -> int:
+    # Chart size after the descent: 3^(-depth/2) for √3 faces, 2^(-depth) for Loop faces.
+    return {"loop": 14, "sqrt3": 18}.get(scheme, 24)
+
+
+class LimitSurface:
+    """The limit surface of a control mesh, evaluated at any point of its input faces.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Control vertices.
+    F : (m, 3) array_like of int
+        Triangles, as for :func:`hybridsub.refine`.
+    sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
+        As for :func:`hybridsub.refine`; every scheme and tag.
+    depth : int, optional
+        Levels of exact local refinement before the last interpolation (default 24 for
+        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``: 1e-12 × the diagonal or better,
+        see ``docs/limit.md``).
+
+    Notes
+    -----
+    Points are ``(face, bary)``: ``bary = (1 − u − v, u, v)`` over ``F[face]``; ``∂/∂u``,
+    ``∂/∂v`` follow OpenSubdiv's triangle convention (corner 0 at (0, 0), 1 at (1, 0), 2 at
+    (0, 1)). Each point is followed through the refinement by exact local refinement with the
+    scheme's own rules, then interpolated from exact limit positions six vertices around it.
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> s = hybridsub.LimitSurface(V, F, scheme="loop")
+    >>> P = s.evaluate([3, 3], [[1, 0, 0], [1/3, 1/3, 1/3]])
+    >>> bool(np.allclose(P[0], hybridsub.limit_positions(V, F, scheme="loop")[1]))
+    True
+    """
+
+    def __init__(self, V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *,
+                 scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+                 corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", depth: int | None = None):
+        X = as_vertices(V)
+        self._inp = open_gate(F, sharp_edges, 0, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
+                              sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+        self._V = X.copy()
+        self._V.setflags(write=False)
+        self._seeds = None
+        if depth is None:
+            depth = _default_depth(scheme)
+        if isinstance(depth, bool) or int(depth) != depth or depth < 0:
+            raise ValueError(f"depth must be a non-negative integer, got {depth!r}")
+        self.depth = int(depth) + (int(depth) % 2 if scheme == "sqrt3" else 0)  # Kobbelt: even levels
+        self._tol, self._max_levels = 1e-12, 60
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """The control vertices (n, 3), read-only."""
+        return self._V
+
+    @property
+    def faces(self) -> np.ndarray:
+        """The input faces (m, 3), read-only view."""
+        F = self._inp.faces.view()
+        F.setflags(write=False)
+        return F
+
+    @property
+    def scheme(self) -> str:
+        return self._inp.scheme
+
+    def _points(self, face, bary):
+        m = self._inp.n_faces
+        f = np.asarray(face)
+        if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.all(f == np.round(f))):
+            raise TypeError(f"face must be integers, got dtype {f.dtype}")
+        f = f.astype(np.int64).reshape(-1)
+        b = np.asarray(bary, dtype=np.float64)
+        if b.ndim == 1 and b.shape[0] == 3 and len(f) == 1:
+            b = b[None]
+        if b.ndim != 2 or b.shape != (len(f), 3):
+            raise ValueError(f"bary must have shape ({len(f)}, 3) to match face, got {b.shape}")
+        bad = np.flatnonzero((f < 0) | (f >= m))
+        if len(bad):
+            raise ValueError(f"face[{bad[0]}] = {f[bad[0]]} is not a face (the mesh has {m} faces)")
+        bad = np.flatnonzero(~np.isfinite(b).all(axis=1) | (b < -1e-9).any(axis=1) | (np.abs(b.sum(axis=1) - 1) > 1e-9))
+        if len(bad):
+            raise ValueError(f"bary[{bad[0]}] = {b[bad[0]].tolist()} is not a point of its face: barycentric "
+                             "coordinates must be >= 0 and sum to 1")
+        b = np.clip(b, 0.0, None)
+        return f, b / b.sum(axis=1, keepdims=True)
+
+    def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
+        inp = self._inp
+        faces0, qn = np.unique(f, return_inverse=True)
+        p, sel0 = D.start(inp, faces0)
+        maps = [sel0]
+        qn, bb = qn.ravel(), b
+        for k in range(depth):
+            p, A, qn, bb = D.step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
+            maps.append(A)
+        ids, w, wu, wv = D.stencil(p, qn, bb)
+        needed = np.unique(ids)
+        L = D.limit_rows(p, needed, inp.scheme, inp.loop_weights, self._tol, self._max_levels)
+        q = len(f)
+        n = p.level.n_vertices
+        out = []
+        for W in (w, wu, wv) if derivatives else (w,):
+            R = sp.csr_matrix((W.ravel(), ids.ravel(), np.arange(0, 6 * q + 1, 6)), shape=(q, n)) @ L
+            for A in reversed(maps):
+                R = R @ A
+            out.append(sp.csr_matrix(R))
+        return out
+
+    def evaluation_matrix(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False):
+        """The sparse rows that give the limit surface at the points: ``evaluate == M @ V``.
+
+        Parameters
+        ----------
+        face : (k,) array_like of int
+            Input faces.
+        bary : (k, 3) array_like of float
+            Barycentric coordinates over ``F[face]`` (non-negative, summing to 1).
+        derivatives : bool
+            Also the rows of ``∂P/∂u`` and ``∂P/∂v``.
+
+        Returns
+        -------
+        M : scipy.sparse.csr_matrix, (k, n)
+            Or ``(M, Mu, Mv)`` with ``derivatives=True``. Rows of ``M`` sum to 1, those of
+            ``Mu``, ``Mv`` to 0; they depend on the connectivity and tags only.
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> s = hybridsub.LimitSurface(V, F, sharp_edges=[[0, 1]])
+        >>> M = s.evaluation_matrix([0, 3], [[0.2, 0.3, 0.5], [1, 0, 0]])
+        >>> M.shape, bool(np.allclose(M.sum(axis=1), 1))
+        ((2, 4), True)
+        """
+        return self._matrix(*self._points(face, bary), derivatives, self.depth)
+
+    def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
+        parts = [[] for _ in range(3 if derivatives else 1)]
+        for i in range(0, len(f), CHUNK):
+            for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
+                acc.append(R)
+        n = self._inp.n_vertices
+        mats = [sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
+        for M in mats:
+            M.sum_duplicates()
+            M.sort_indices()
+        return tuple(mats) if derivatives else mats[0]
+
+    def evaluate(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False, *,
+                 vertices: ArrayLike | None = None):
+        """Points of the limit surface (k, 3); with ``derivatives=True`` also ``∂P/∂u``, ``∂P/∂v``.
+
+        ``vertices`` (n, d) evaluates the same surface with other control positions (or any
+        per-vertex data): the rows depend on the connectivity and tags only.
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> s = hybridsub.LimitSurface(V, F, scheme="loop")
+        >>> P, Du, Dv = s.evaluate([3], [[0.25, 0.25, 0.5]], derivatives=True)
+        >>> P.shape, Du.shape
+        ((1, 3), (1, 3))
+        >>> bool(np.allclose(s.evaluate([3], [[0.25, 0.25, 0.5]], vertices=2 * V), 2 * P))
+        True
+        """
+        X = self._data(vertices)
+        mats = self.evaluation_matrix(face, bary, derivatives)
+        if derivatives:
+            return tuple(np.asarray(M @ X) for M in mats)
+        return np.asarray(mats @ X)
+
+    def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
+        """Unit normals ``∂P/∂u × ∂P/∂v`` (k, 3) (one-sided at creases: the given face's side).
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> N = hybridsub.LimitSurface(V, F).normals([3], [[1/3, 1/3, 1/3]])
+        >>> N.round(6).tolist()                       # the face (1, 2, 3) faces away from 0
+        [[0.57735, 0.57735, 0.57735]]
+        """
+        _, Du, Dv = self.evaluate(face, bary, derivatives=True, vertices=vertices)
+        N = np.cross(Du, Dv)
+        norm = np.linalg.norm(N, axis=1, keepdims=True)
+        return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
+
+    def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iter: int = 30):
+        """Closest points of the limit surface: ``(face, bary, Q, dist)``.
+
+        ``dist`` is signed: positive on the side the normals point to. Seeds come from a dense
+        sampling of the surface; Gauss–Newton on (face, u, v) then walks across face
+        boundaries to the foot point (``docs/limit.md``).
+
+        Examples
+        --------
+        >>> import numpy as np, hybridsub
+        >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> s = hybridsub.LimitSurface(V, F, depth=12)
+        >>> P = s.evaluate([3], [[0.3, 0.3, 0.4]]); N = s.normals([3], [[0.3, 0.3, 0.4]])
+        >>> face, bary, Q, dist = s.project(P + 0.01 * N)
+        >>> bool(np.allclose(Q, P, atol=1e-12)), bool(np.isclose(dist[0], 0.01, atol=1e-12))
+        (True, True)
+        """
+        X = self._V if vertices is None else as_vertices(vertices)
+        if len(X) != self._inp.n_vertices:
+            raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got {len(X)}")
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim == 1 and pts.shape == (3,):
+            pts = pts[None]
+        if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
+            raise ValueError(f"points must be a finite (k, 3) array, got shape {pts.shape}")
+        return closest_points(self, X, pts, max_iter)
+
+    def _data(self, vertices):
+        if vertices is None:
+            return self._V
+        X = np.asarray(vertices, dtype=np.float64)
+        if X.ndim not in (1, 2) or X.shape[0] != self._inp.n_vertices:
+            raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got shape "
+                             f"{X.shape}")
+        return X
+
+    def _seed_setup(self):
+        """The limit points of two refined levels and where they lie (computed once)."""
+        if self._seeds is None:
+            self._seeds = seed_setup(self._inp)
+        return self._seeds

@@ -1,0 +1,191 @@
+"""The limit surface anywhere (issue 14): LimitSurface.evaluate / evaluation_matrix / normals /
+project, and Refinement.vertex_origin."""
+
+import pathlib
+
+import numpy as np
+import pytest
+
+import hybridsub
+
+# An octahedron, jittered: every vertex of valence 4 (extraordinary in every scheme).
+OCTA_V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+OCTA_V = OCTA_V + 0.1 * np.random.default_rng(0).standard_normal(OCTA_V.shape)
+OCTA_F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+# An open fan of five triangles around vertex 0 (boundary, valence 6 at the centre).
+FAN_V = np.array([[0.0, 0, 0.3]] + [[np.cos(a), np.sin(a), 0.1 * np.sin(3 * a)]
+                                    for a in np.linspace(0, 2 * np.pi, 7)[:-1]])
+FAN_F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 6]])
+
+CASES = {
+    "loop-crease-corner": (OCTA_V, OCTA_F, dict(scheme="loop", sharp_edges=[[0, 2], [2, 1], [1, 3]], corners=[3])),
+    "loop-semisharp": (OCTA_V, OCTA_F, dict(scheme="loop", sharp_edges=[[0, 2], [2, 1]], sharpness=[0.5, 1.5])),
+    "sqrt3-closed": (OCTA_V, OCTA_F, dict(scheme="sqrt3")),
+    "sqrt3-boundary": (FAN_V, FAN_F, dict(scheme="sqrt3")),
+    "hybrid-crease": (OCTA_V, OCTA_F, dict(scheme="hybrid", sharp_edges=[[0, 2], [2, 1], [1, 3], [3, 0]])),
+    "hybrid-mixed-dart": (OCTA_V, OCTA_F, dict(scheme="hybrid", sharp_edges=[[0, 4]], sharp_faces=[0, 1, 5])),
+    "hybrid-boundary": (FAN_V, FAN_F, dict(scheme="hybrid", corners=[1])),
+}
+
+
+def _diag(V):
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+FAST = ("loop-crease-corner", "sqrt3-boundary", "hybrid-crease")
+
+
+@pytest.mark.parametrize("name", [n if n in FAST else pytest.param(n, marks=pytest.mark.slow) for n in CASES])
+def test_refined_vertices_evaluate_to_their_limit_positions(name):
+    """evaluate(*r.vertex_origin) == limit_positions(levels=L): rational parameters are exact."""
+    V, F, kw = CASES[name]
+    s = hybridsub.LimitSurface(V, F, depth=4, **kw)
+    for levels in (1, 2):
+        r = hybridsub.refine(F, levels=levels, **kw)
+        face, bary = r.vertex_origin
+        ref = hybridsub.limit_positions(V, F, levels=levels, **kw)
+        assert np.abs(s.evaluate(face, bary) - ref).max() < 1e-12 * _diag(V), (name, levels)
+
+
+def test_vertex_origin_follows_the_chart():
+    r = hybridsub.refine(OCTA_F, levels=2, scheme="sqrt3")
+    face, bary = r.vertex_origin
+    assert face.shape == (r.n_vertices,) and bary.shape == (r.n_vertices, 3)
+    assert (bary >= 0).all() and np.allclose(bary.sum(axis=1), 1)
+    # Old vertices sit at their own corner; two √3 steps trisect the old edges.
+    own = OCTA_F[face[:6], np.argmax(bary[:6], axis=1)]
+    assert np.array_equal(own, np.arange(6)) and np.allclose(bary[:6].max(axis=1), 1)
+    pos = np.einsum("kc,kcd->kd", bary, OCTA_V[OCTA_F[face]])  # the chart mapped linearly onto the faces
+    a, b = OCTA_V[0], OCTA_V[2]
+    on_edge = [np.min(np.linalg.norm(pos - (a + t * (b - a)), axis=1)) for t in (1 / 3, 2 / 3)]
+    assert max(on_edge) < 1e-12
+    # Loop: the edge points are the midpoints, in every face that holds them.
+    r = hybridsub.refine(OCTA_F, levels=1, scheme="loop")
+    face, bary = r.vertex_origin
+    assert np.allclose(np.sort(bary[6:], axis=1), [0, 0.5, 0.5])
+    with pytest.raises(ValueError, match="cut"):
+        hybridsub.refine(np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]]), levels=1, non_manifold="cut").vertex_origin
+
+
+@pytest.mark.parametrize("name", ["hybrid-crease", pytest.param("loop-crease-corner", marks=pytest.mark.slow),
+                                  pytest.param("sqrt3-boundary", marks=pytest.mark.slow)])
+def test_the_same_point_from_both_faces_of_an_edge(name):
+    V, F, kw = CASES[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    # Every interior edge, at an irrational parameter.
+    h = np.array([(f, i) for f in range(len(F)) for i in range(3)])
+    a, b = F[h[:, 0], h[:, 1]], F[h[:, 0], (h[:, 1] + 1) % 3]
+    t = 0.3137
+    P, Q = [], []
+    for (f, i), u, w in zip(h, a, b):
+        for g in range(len(F)):
+            if g != f and u in F[g] and w in F[g]:
+                bf = np.zeros(3); bf[i], bf[(i + 1) % 3] = 1 - t, t
+                bg = np.zeros(3); bg[list(F[g]).index(u)], bg[list(F[g]).index(w)] = 1 - t, t
+                P.append((f, bf)); Q.append((g, bg))
+    PP = s.evaluate([p[0] for p in P], [p[1] for p in P])
+    QQ = s.evaluate([q[0] for q in Q], [q[1] for q in Q])
+    assert np.abs(PP - QQ).max() < 1e-12 * _diag(V)
+
+
+@pytest.mark.parametrize("name", ["hybrid-mixed-dart", pytest.param("loop-crease-corner", marks=pytest.mark.slow),
+                                  pytest.param("sqrt3-closed", marks=pytest.mark.slow)])
+def test_derivatives_agree_with_finite_differences(name):
+    V, F, kw = CASES[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    face = np.array([0, 3, 6])
+    uv = np.array([[0.3, 0.25], [0.41, 0.17], [0.2, 0.55]])
+    e = 1e-4
+
+    def at(duv):
+        w = uv + duv
+        return np.c_[1 - w.sum(axis=1), w]
+
+    P, Du, Dv = s.evaluate(face, at(0), derivatives=True)
+    fd_u = (s.evaluate(face, at([e, 0])) - s.evaluate(face, at([-e, 0]))) / (2 * e)
+    fd_v = (s.evaluate(face, at([0, e])) - s.evaluate(face, at([0, -e]))) / (2 * e)
+    scale = np.abs(Du).max()
+    assert np.abs(Du - fd_u).max() < 1e-5 * scale and np.abs(Dv - fd_v).max() < 1e-5 * scale
+
+
+def test_evaluation_matrix_is_what_evaluate_applies():
+    V, F, kw = CASES["hybrid-crease"]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    face, bary = np.array([0, 5, 7]), np.array([[0.2, 0.3, 0.5], [0.1, 0.1, 0.8], [1, 0, 0]])
+    M, Mu, Mv = s.evaluation_matrix(face, bary, derivatives=True)
+    assert M.shape == (3, 6) and np.allclose(M.sum(axis=1), 1)
+    for D in (Mu[:2], Mv[:2]):  # rows sum to 0 (not asked at the crease vertex: no tangent plane there)
+        assert (np.abs(D.sum(axis=1)).A1 < 1e-9 * abs(D).sum(axis=1).A1).all()
+    P, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    assert np.array_equal(M @ V, P) and np.array_equal(Mu @ V, Du)
+    # Other control positions through the same rows; the surface is affine invariant.
+    V2 = 2.0 * V + [1.0, -2.0, 0.5]
+    assert np.allclose(s.evaluate(face, bary, vertices=V2), 2.0 * P + [1.0, -2.0, 0.5], atol=1e-14)
+    assert np.array_equal(s.evaluation_matrix(face, bary).toarray(), M.toarray())
+    assert s.vertices.shape == (6, 3) and np.array_equal(s.faces, F) and not s.vertices.flags.writeable
+
+
+def test_normals_at_smooth_vertices_are_limit_normals():
+    V, F, kw = CASES["loop-semisharp"]
+    kw = dict(scheme="loop")
+    s = hybridsub.LimitSurface(V, F, **kw)
+    ref = hybridsub.limit_normals(V, F, **kw)
+    N = s.normals(np.arange(8), np.tile([1.0, 0, 0], (8, 1)))  # corner 0 of every face
+    assert np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", N, ref[F[:, 0]]), -1, 1))).max() < 1e-3
+    assert np.allclose(np.linalg.norm(N, axis=1), 1)
+
+
+def test_project_returns_points_pushed_off_along_the_normal():
+    V, F, kw = CASES["hybrid-crease"]
+    s = hybridsub.LimitSurface(V, F, depth=14, **kw)  # 1e-10 or better here; the default is finer
+    face = np.array([0, 2, 5, 7])
+    bary = np.array([[0.2, 0.3, 0.5], [0.5, 0.25, 0.25], [0.3, 0.3, 0.4], [0.6, 0.3, 0.1]])
+    P = s.evaluate(face, bary)
+    N = s.normals(face, bary)
+    d = np.array([0.05, -0.03, 0.1, 0.02])
+    f2, b2, Q, dist = s.project(P + d[:, None] * N)
+    diag = _diag(V)
+    assert np.abs(Q - P).max() < 1e-9 * diag
+    assert np.abs(dist - d).max() < 1e-9 * diag
+    assert np.abs(s.evaluate(f2, b2) - Q).max() < 1e-12 * diag
+
+
+def test_bad_points_are_named():
+    s = hybridsub.LimitSurface(OCTA_V, OCTA_F, depth=2)
+    with pytest.raises(ValueError, match=r"face\[1\] = 8 is not a face"):
+        s.evaluate([0, 8], [[1, 0, 0], [1, 0, 0]])
+    with pytest.raises(ValueError, match=r"bary\[1\]"):
+        s.evaluate([0, 1], [[1, 0, 0], [0.5, 0.7, -0.2]])
+    with pytest.raises(ValueError, match="shape"):
+        s.evaluate([0, 1], [[1, 0, 0]])
+    with pytest.raises(ValueError, match="rows"):
+        s.evaluate([0], [[1, 0, 0]], vertices=np.zeros((5, 3)))
+    with pytest.raises(hybridsub.MeshError):
+        hybridsub.LimitSurface(OCTA_V, OCTA_F, sharp_edges=[[0, 1]])  # not an edge
+
+
+@pytest.mark.parametrize("scheme", ["sqrt3", pytest.param("loop", marks=pytest.mark.slow)])
+def test_deeper_levels_are_exact_too(scheme):
+    """Levels 3 and 4: refined faces reach round input vertices (the chart unfolds there)."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])  # valence 3: the chart is far from flat
+    for levels in (3, 4) if scheme == "sqrt3" else (3,):
+        r = hybridsub.refine(F, levels=levels, scheme=scheme)
+        s = hybridsub.LimitSurface(V, F, scheme=scheme, depth=levels)
+        ref = hybridsub.limit_positions(V, F, levels=levels, scheme=scheme)
+        assert np.abs(s.evaluate(*r.vertex_origin) - ref).max() < 1e-12
+
+
+def test_loop_equals_opensubdiv_bfr_on_regular_patches():
+    """tests/data/fandisk.bfr_loop.npz: OpenSubdiv 3.5 Bfr at random points of its regular patches
+    (exact there), written by ``benchmarks/limit_surface.py --reference``."""
+    ref = np.load(pathlib.Path(__file__).parent / "data" / "fandisk.bfr_loop.npz")
+    V, F = hybridsub.load_example()
+    s = hybridsub.LimitSurface(V, F, ref["sharp_edges"], scheme="loop")
+    k = 16
+    P, Du, Dv = s.evaluate(ref["face"][:k], ref["bary"][:k], derivatives=True)
+    diag = _diag(V)
+    assert np.abs(P - ref["P"][:k]).max() < 1e-12 * diag
+    # Bfr's derivatives are exact too; ours carry the last interpolation's error.
+    assert np.abs(Du - ref["Du"][:k]).max() < 1e-6 * np.abs(ref["Du"][:k]).max()
+    assert np.abs(Dv - ref["Dv"][:k]).max() < 1e-6 * np.abs(ref["Dv"][:k]).max()
