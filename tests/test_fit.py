@@ -123,3 +123,26 @@ def test_closest_points_match_brute_force_as_the_mesh_moves():
     long = np.array([[0.0, 0, 0], [100, 0, 0], [0, 0.1, 0], [50, 1, 0]])   # one long sliver among small faces
     fp = closest_points(long, np.array([[0, 1, 2], [1, 3, 2]]), np.array([[90.0, 0.01, 1]]))
     assert fp.face.tolist() == [0] and abs(fp.distance[0] - 1) < 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scheme", ["hybrid", "sqrt3", "loop"])
+def test_points_on_the_limit_surface_are_fitted_exactly(scheme):
+    rng = np.random.default_rng(7)
+    sharp = None if scheme == "sqrt3" else CREASES
+    kw = dict(scheme=scheme, sharp_faces=[0, 5] if scheme == "hybrid" else None)
+    n = 300
+    pts = hybridsub.LimitSurface(VC, FC, sharp, **kw).evaluate(rng.integers(0, len(FC), n),
+                                                                 rng.dirichlet([1, 1, 1], n))
+    start = VC + 0.05 * EDGE * rng.normal(size=VC.shape) / np.sqrt(3)
+    res = hybridsub.fit(FC, pts, sharp, V0=start, max_iterations=8, **kw)
+    diag = np.linalg.norm(pts.max(0) - pts.min(0))
+    assert np.abs(res.vertices - VC).max() < 1e-8 * diag
+
+
+@pytest.mark.slow
+def test_the_limit_fit_takes_a_step_toward_the_points():
+    rng = np.random.default_rng(8)
+    pts = hybridsub.LimitSurface(VC, FC, CREASES).evaluate(rng.integers(0, len(FC), 40), rng.dirichlet([1, 1, 1], 40))
+    res = hybridsub.fit(FC, pts, CREASES, V0=VC + 0.02 * EDGE, max_iterations=1)
+    assert res.history["rms"][1] < 0.2 * res.history["rms"][0]

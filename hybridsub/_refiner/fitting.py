@@ -32,6 +32,7 @@ from .._input import as_vertices
 from .._typing import ArrayLike, LoopWeights, Scheme
 from ._closest_kernels import face_systems
 from .closest import ClosestPoints
+from .limit import LimitSurface
 from .refinement import refine
 
 TANGENT_WEIGHT = 1e-6   # λ: the tangential damping
@@ -198,7 +199,7 @@ class LevelSurface:
         # Off the triangle's interior, the distance grows along the offset, not the face normal.
         rim = (fp.bary <= 0.0).any(axis=1) & (fp.distance > 0.0)
         normals[rim] = residual[rim]
-        return Feet(E, fp.face, fp.bary, _unit(normals), residual, fp.distance)
+        return Feet(E, fp.face, fp.bary, _unit(normals, residual), residual, fp.distance)
 
     def system(self, feet: Feet, weight: float, lam: float):
         """``H`` and ``g`` on the control points: the data term summed per face of the level
@@ -218,12 +219,32 @@ class LevelSurface:
         return sandwich(H, self.S), S3t @ g
 
 
-def _unit(N: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(N, axis=1)
+class LimitFitSurface:
+    """The limit surface: closest points by :meth:`LimitSurface.project`, rows by its
+    ``evaluation_matrix`` (which depends on connectivity and tags only)."""
+
+    def __init__(self, surface: LimitSurface):
+        self.surface = surface
+
+    def feet(self, V: np.ndarray, points: np.ndarray) -> Feet:
+        face, bary, Q, _ = self.surface.project(points, vertices=V)
+        E, Eu, Ev = self.surface.evaluation_matrix(face, bary, derivatives=True)
+        residual = E @ V - points
+        normals = _unit(np.cross(Eu @ V, Ev @ V), residual)
+        return Feet(sp.csr_matrix(E), face, bary, normals, residual, np.linalg.norm(residual, axis=1))
+
+    def system(self, feet: Feet, weight: float, lam: float):
+        return normal_system(feet.E, feet.normals, feet.residual, weight, lam)
+
+
+def _unit(N: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """Unit rows of N; where N vanishes (a degenerate face), the residual's direction, else z."""
     out = np.zeros_like(N)
-    ok = length > 0
-    out[ok] = N[ok] / length[ok, None]
-    out[~ok, 2] = 1.0
+    for X in (N, residual):
+        length = np.linalg.norm(X, axis=1)
+        ok = (length > 0) & ~out.any(axis=1)
+        out[ok] = X[ok] / length[ok, None]
+    out[~out.any(axis=1), 2] = 1.0
     return out
 
 
@@ -259,8 +280,9 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
         target's own samples, its vertex i at ``points[i]``, roughly over the target; no
         registration is made).
     levels : int, optional
-        Fit the level-``levels`` refined mesh (piecewise linear, exact closest points); default
-        None fits the limit surface.
+        Fit the level-``levels`` refined mesh (piecewise linear, exact closest points, fast);
+        default None fits the limit surface (:class:`hybridsub.LimitSurface`: its ``project``
+        and ``evaluation_matrix``, exact but much slower per point).
     smoothness : float
         Weight μ of the fairness term ``μ / n ||L V||²`` beside the mean squared distance
         (``L``: umbrella operator of the control mesh, creases as curves, corners free).
@@ -294,7 +316,11 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     n = r.n_coarse
     V = _start(V0, pts, n)
     max_iterations, tol, smoothness = _check_numbers(max_iterations, tol, smoothness)
-    surface = LevelSurface(r, pts)
+    if levels is None:
+        surface = LimitFitSurface(LimitSurface(V, F, sharp_edges, scheme=scheme, sharpness=sharpness,
+                                               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights))
+    else:
+        surface = LevelSurface(r, pts)
     smooth = None
     if smoothness > 0:
         r0 = r if levels == 0 else refine(F, sharp_edges, 0, scheme=scheme, sharpness=sharpness,
