@@ -35,7 +35,9 @@ from .closest import ClosestPoints
 from .limit import LimitSurface
 from .refinement import refine
 
-TANGENT_WEIGHT = 1e-6   # λ: the tangential damping
+TANGENT_WEIGHT = 1e-6       # λ near the target: the tangential damping
+TANGENT_WEIGHT_MAX = 1e-2   # λ far from it (λ = RMS / diagonal in between)
+_MAX_HALVINGS = 30
 _RIDGE = 1e-12          # relative ridge on the update: vertices no point reaches stay put
 _CG_RTOL = 1e-10
 _CG_MAXITER = 40
@@ -299,13 +301,20 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     FitResult
         ``vertices``, ``rms``, ``max_error``, ``iterations``, ``converged``, ``history``.
 
+    Notes
+    -----
+    The tangential damping λ is RMS / diagonal clamped to [1e-6, 1e-2] (firm far from the
+    target, vanishing near it), and an update that raises the error is halved (up to 30
+    times) before the next, so far starts converge too, more slowly.
+
     Examples
     --------
     >>> import numpy as np, hybridsub
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     >>> r = hybridsub.refine(F, levels=2)
-    >>> target = r.apply(V * [1.0, 1.5, 2.0])          # a stretched tetrahedron's level 2 vertices
+    >>> P = r.apply(V * [1.0, 1.5, 2.0])               # a stretched tetrahedron's level 2
+    >>> target = np.vstack([P, P[r.faces].mean(axis=1)])  # its vertices and face centres
     >>> res = hybridsub.fit(F, target, V0=V, levels=2)
     >>> bool(res.converged), bool(res.rms < 1e-9)
     (True, True)
@@ -333,36 +342,50 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
 
 
 def _iterate(surface, V, pts, smooth, max_iterations, tol, callback) -> FitResult:
+    """The fit loop: project, update, and halve an update that raised the error."""
     t0 = time.perf_counter()
-    n, m = len(V), len(pts)
     diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) or 1.0
     solver = Solver()
-    rows, converged, it, energy = [], False, 0, np.inf
+    rows, converged, it, energy, halvings = [], False, 0, np.inf, 0
     while True:
         feet = surface.feet(V, pts)
         d = feet.distance
         rms, mx = float(np.sqrt(np.mean(d * d))), float(d.max())
+        e = rms * rms + (0.0 if smooth is None else float((V * (smooth @ V)).sum()))
+        if e > energy * (1 + 1e-9) and halvings < _MAX_HALVINGS:   # overshot: back half the way
+            dx *= 0.5
+            V = V - dx
+            halvings += 1
+            continue
+        halvings = 0
+        if rows:
+            rows[-1][2] = float(np.abs(V - V_prev).max())
         rows.append([rms, mx, 0.0, time.perf_counter() - t0])
         if callback is not None:
             callback(it, rms, mx)
-        e = rms * rms + (0.0 if smooth is None else float((V * (smooth @ V)).sum()))
-        if it and (0.0 <= energy - e <= tol * energy or rms <= tol * diag):
+        if it and (0.0 <= energy - e <= tol * energy or rms <= tol * diag or rows[-2][2] <= tol * diag):
             converged = True
         if converged or it >= max_iterations:
             break
-        energy = e
-        H, g = surface.system(feet, 1.0 / m, TANGENT_WEIGHT)
-        if smooth is not None:
-            H = H + sp.block_diag([smooth] * 3)
-            g = g + (smooth @ V).T.ravel()
-        H = sp.csc_matrix(H + (_RIDGE * H.diagonal().mean()) * sp.identity(3 * n))
-        dx = solver.solve(H, -g).reshape(3, n).T
+        energy, V_prev = e, V
+        # The tangential damping shrinks with the distance: firm far from the target, ~0 at it.
+        lam = min(TANGENT_WEIGHT_MAX, max(TANGENT_WEIGHT, rms / diag))
+        dx = _update(surface, feet, smooth, V, lam, solver)
         V = V + dx
         it += 1
-        rows[-1][2] = float(np.abs(dx).max())
-        converged = rows[-1][2] <= tol * diag
     hist = np.array([tuple(x) for x in rows], dtype=HISTORY_DTYPE)
     return FitResult(V, rms, mx, it, converged, hist)
+
+
+def _update(surface, feet: Feet, smooth, V: np.ndarray, lam: float, solver: Solver) -> np.ndarray:
+    """The least-squares update of the control positions, (n, 3)."""
+    n, m = len(V), len(feet.distance)
+    H, g = surface.system(feet, 1.0 / m, lam)
+    if smooth is not None:
+        H = H + sp.block_diag([smooth] * 3)
+        g = g + (smooth @ V).T.ravel()
+    H = sp.csc_matrix(H + (_RIDGE * H.diagonal().mean()) * sp.identity(3 * n))
+    return solver.solve(H, -g).reshape(3, n).T
 
 
 def _start(V0, pts: np.ndarray, n: int) -> np.ndarray:
