@@ -146,3 +146,16 @@ def test_the_limit_fit_takes_a_step_toward_the_points():
     pts = hybridsub.LimitSurface(VC, FC, CREASES).evaluate(rng.integers(0, len(FC), 40), rng.dirichlet([1, 1, 1], 40))
     res = hybridsub.fit(FC, pts, CREASES, V0=VC + 0.02 * EDGE, max_iterations=1)
     assert res.history["rms"][1] < 0.2 * res.history["rms"][0]
+
+
+def test_closest_points_fall_back_to_every_face(monkeypatch):
+    import hybridsub._refiner.closest as closest
+
+    monkeypatch.setattr(closest, "_MAX_CANDIDATES", 8)
+    V, F = load_mesh("mesh_with_border")
+    rng = np.random.default_rng(10)
+    q = V[rng.integers(0, len(V), 50)] + 0.5 * rng.normal(size=(50, 3))    # far: the bound settles few
+    fp = closest_points(V, F, q)
+    f, b, d2 = np.full(len(q), -1), np.zeros((len(q), 3)), np.full(len(q), np.inf)
+    closest_among(q, V, F, np.tile(np.arange(len(F)), (len(q), 1)), f, b, d2)
+    assert np.abs(fp.distance - np.sqrt(d2)).max() < 1e-15

@@ -19,6 +19,7 @@ from ._closest_kernels import closest_among
 
 _FIRST_CANDIDATES = 8
 _MAX_SPLIT = 16
+_MAX_CANDIDATES = 256
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,7 +61,7 @@ class ClosestPoints:
     a triangle is within ρ' = max r / s of one of its samples. A triangle none of whose
     samples is among a query's k nearest (the k-th at distance D) is then at least D − ρ'
     away: a query is settled once D − ρ' reaches its best distance; the others are asked
-    again with twice the candidates. Each :meth:`search` first tries the candidates of the
+    again with twice the candidates (past 256, every face is tried). Each :meth:`search` first tries the candidates of the
     last query, with D lowered by how far the mesh's vertices moved since (summed), so a
     fit whose surface moves less and less asks the tree for fewer and fewer points.
     """
@@ -109,8 +110,23 @@ class ClosestPoints:
                 self.candidates[todo], self.kth[todo], self.drift[todo] = cand, kth, 0.0
             todo = todo[kth - rho < np.sqrt(d)]
             k = min(2 * k, len(owner))
+            if k > _MAX_CANDIDATES and len(todo):  # far from a coarse, uneven mesh: try every face
+                _every_face(queries, P, faces, todo, face, bary, d2)
+                break
         Q = np.einsum("mi,mij->mj", bary, P[faces[face]])
         return Footpoints(face, bary, Q, np.sqrt(d2))
+
+
+def _every_face(queries, P, faces, todo, face, bary, d2, chunk_bytes=1 << 24) -> None:
+    """The closest point of each query in ``todo`` among all faces, in chunks of queries."""
+    nf = len(faces)
+    step = max(1, chunk_bytes // (8 * nf))
+    for lo in range(0, len(todo), step):
+        t = todo[lo:lo + step]
+        every = np.tile(np.arange(nf, dtype=np.int64), (len(t), 1))
+        f, b, d = face[t], bary[t], d2[t]
+        closest_among(queries[t], P, faces, every, f, b, d)
+        face[t], bary[t], d2[t] = f, b, d
 
 
 def _samples(tri: np.ndarray, split: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
