@@ -177,9 +177,9 @@ def test_deeper_levels_are_exact_too(scheme):
 
 
 def test_loop_equals_opensubdiv_bfr_on_regular_patches():
-    """tests/data/fandisk.bfr_loop.npz: OpenSubdiv 3.5 Bfr at random points of its regular patches
+    """tests/data/bfr/fandisk_loop.npz: OpenSubdiv 3.5 Bfr at random points of its regular patches
     (exact there), written by ``benchmarks/limit_surface.py --reference``."""
-    ref = np.load(pathlib.Path(__file__).parent / "data" / "fandisk.bfr_loop.npz")
+    ref = np.load(pathlib.Path(__file__).parent / "data" / "bfr" / "fandisk_loop.npz")
     V, F = hybridsub.load_example()
     s = hybridsub.LimitSurface(V, F, ref["sharp_edges"], scheme="loop")
     k = 16
@@ -189,3 +189,22 @@ def test_loop_equals_opensubdiv_bfr_on_regular_patches():
     # Bfr's derivatives are exact too; ours carry the last interpolation's error.
     assert np.abs(Du - ref["Du"][:k]).max() < 1e-6 * np.abs(ref["Du"][:k]).max()
     assert np.abs(Dv - ref["Dv"][:k]).max() < 1e-6 * np.abs(ref["Dv"][:k]).max()
+
+
+@pytest.mark.slow
+def test_far_points_land_on_the_closest_point():
+    """Points a few edge lengths away: no sample of the surface is closer, and the foot point is
+    a critical point of the distance (x − Q ⟂ Du, Dv)."""
+    s = hybridsub.LimitSurface(OCTA_V, OCTA_F, scheme="loop", depth=10)
+    pts = np.random.default_rng(3).standard_normal((5, 3)) * 1.5
+    face, bary, Q, dist = s.project(pts)
+    g = np.linspace(0, 1, 21)
+    U, W = np.meshgrid(g, g)
+    keep = U + W <= 1
+    grid = np.c_[1 - U[keep] - W[keep], U[keep], W[keep]]
+    samples = s.evaluate(np.repeat(np.arange(8), len(grid)), np.tile(grid, (8, 1)))
+    nearest = np.linalg.norm(pts[:, None] - samples[None], axis=2).min(axis=1)
+    assert (np.abs(dist) <= nearest + 1e-12).all()
+    _, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    r = pts - Q
+    assert np.abs(np.einsum("ij,ij->i", r, Du)).max() < 1e-9 and np.abs(np.einsum("ij,ij->i", r, Dv)).max() < 1e-9

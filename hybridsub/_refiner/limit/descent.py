@@ -190,8 +190,9 @@ def _basis(P):
 
 
 def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
-    """Interpolation of the last level: vertex ids (q, 6), weights for the value and for ∂/∂u,
-    ∂/∂v (q, 6 each) at every point, from six vertices around it (quadratic in the chart)."""
+    """Interpolation of the last level: vertex ids (q, 6), weights for the value, ∂/∂u, ∂/∂v,
+    ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (q, 6 each) at every point, from six vertices around it (quadratic
+    in the chart; second derivatives zero where it falls back to linear)."""
     lvl = p.level
     nbr, R, t = glue_maps(p.shape, lvl.twin, p.face)
     tw = lvl.twin[3 * p.face[:, None] + np.arange(3)]
@@ -213,16 +214,19 @@ def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
     x = (np.einsum("qc,qcd->qd", bary, here[qnode]) - c0[qnode, 0]) / scale[qnode, 0]
     s, u = x[:, 0], x[:, 1]
     z, o = np.zeros_like(s), np.ones_like(s)
-    rhs = np.stack([_basis(x), np.stack([z, o, z, 2 * s, u, z], -1), np.stack([z, z, o, z, s, 2 * u], -1)], -1)
-    W = np.linalg.solve(np.swapaxes(A, 1, 2)[qnode], rhs)  # (q, 6, 3): value, d/ds, d/dt weights
+    t2 = 2 * o
+    rhs = np.stack([_basis(x), np.stack([z, o, z, 2 * s, u, z], -1), np.stack([z, z, o, z, s, 2 * u], -1),
+                    np.stack([z, z, z, t2, z, z], -1), np.stack([z, z, z, z, o, z], -1),
+                    np.stack([z, z, z, z, z, t2], -1)], -1)
+    W = np.linalg.solve(np.swapaxes(A, 1, 2)[qnode], rhs)  # (q, 6, 6): value, d/ds, d/dt, d²/ds², d²/dsdt, d²/dt²
     lin = ~full[qnode]
     if lin.any():  # a boundary face or a sliver: linear interpolation
         W[lin] = 0.0
         W[lin, :3, 0] = bary[lin]
         E = here[qnode[lin]] / scale[qnode[lin]]
         Minv = np.linalg.inv(np.stack([E[:, 1] - E[:, 0], E[:, 2] - E[:, 0]], -1))  # rows: d bary1,2 / d(s,t)
-        W[lin, 1:3, 1:] = Minv
-        W[lin, 0, 1:] = -Minv.sum(axis=1)
+        W[lin, 1:3, 1:3] = Minv
+        W[lin, 0, 1:3] = -Minv.sum(axis=1)
     at = np.flatnonzero(bary.max(axis=1) >= 1.0 - 1e-14)  # at a vertex: its limit position exactly
     W[at, :, 0] = 0.0
     W[at, np.argmax(bary[at], axis=1), 0] = 1.0
@@ -234,4 +238,7 @@ def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
     J = Mx @ np.linalg.inv(Mu)  # ∂(s,t)/∂(u,v)
     Wu = W[:, :, 1] * J[:, None, 0, 0] + W[:, :, 2] * J[:, None, 1, 0]
     Wv = W[:, :, 1] * J[:, None, 0, 1] + W[:, :, 2] * J[:, None, 1, 1]
-    return ids[qnode], W[:, :, 0], Wu, Wv
+    # Second derivatives (constant over the stencil; for Newton's method in project): Jᵀ H J.
+    H = np.stack([np.stack([W[:, :, 3], W[:, :, 4]], -1), np.stack([W[:, :, 4], W[:, :, 5]], -1)], -1)
+    Huv = np.einsum("qai,qkab,qbj->qkij", J, H, J)
+    return ids[qnode], W[:, :, 0], Wu, Wv, Huv[:, :, 0, 0], Huv[:, :, 0, 1], Huv[:, :, 1, 1]

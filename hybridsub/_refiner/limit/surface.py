@@ -116,13 +116,13 @@ class LimitSurface:
         for k in range(depth):
             p, A, qn, bb = D.step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
             maps.append(A)
-        ids, w, wu, wv = D.stencil(p, qn, bb)
+        ids, *weights = D.stencil(p, qn, bb)
         needed = np.unique(ids)
         L = D.limit_rows(p, needed, inp.scheme, inp.loop_weights, self._tol, self._max_levels)
         q = len(f)
         n = p.level.n_vertices
         out = []
-        for W in (w, wu, wv) if derivatives else (w,):
+        for W in weights[:[1, 3, 6][int(derivatives)]]:
             R = sp.csr_matrix((W.ravel(), ids.ravel(), np.arange(0, 6 * q + 1, 6)), shape=(q, n)) @ L
             for A in reversed(maps):
                 R = R @ A
@@ -160,7 +160,7 @@ class LimitSurface:
         return self._matrix(*self._points(face, bary), derivatives, self.depth)
 
     def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
-        parts = [[] for _ in range(3 if derivatives else 1)]
+        parts = [[] for _ in range([1, 3, 6][int(derivatives)])]
         for i in range(0, len(f), CHUNK):
             for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
                 acc.append(R)
@@ -169,7 +169,7 @@ class LimitSurface:
         for M in mats:
             M.sum_duplicates()
             M.sort_indices()
-        return tuple(mats) if derivatives else mats[0]
+        return tuple(mats) if derivatives else mats[0]  # derivatives=2 (project): second derivatives too
 
     def evaluate(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False, *,
                  vertices: ArrayLike | None = None):
