@@ -29,13 +29,15 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr_
     from ._input import Features, detect_features
     from ._io import TaggedMesh, load_example, read_mesh, write_mesh
     from ._jit import set_threads
-    from ._refiner import (FaceVaryingRefinement, LimitSurface, Refinement, RefinementStep, get_memory_limit,
-                           limit_matrix, limit_normals, limit_positions, refine, refine_face_varying, seam_edges,
-                           set_memory_limit, subdivide, subdivide_face_varying)
+    from ._refiner import (FaceVaryingRefinement, FitResult, LimitSurface, MultiresDetails, Refinement,
+                           RefinementStep, fit, get_memory_limit, limit_matrix, limit_normals, limit_positions,
+                           refine, refine_face_varying, seam_edges, set_memory_limit, subdivide,
+                           subdivide_face_varying)
 
 #: Where each public name lives (imported when first used).
 _HOMES = {
-    "._refiner": ("FaceVaryingRefinement", "LimitSurface", "Refinement", "RefinementStep", "get_memory_limit",
+    "._refiner": ("FaceVaryingRefinement", "FitResult", "LimitSurface", "MultiresDetails", "Refinement",
+                  "RefinementStep", "fit", "get_memory_limit",
                   "limit_matrix", "limit_normals", "limit_positions", "refine", "refine_face_varying", "seam_edges",
                   "set_memory_limit", "subdivide", "subdivide_face_varying"),
     "._input": ("Features", "detect_features"),
@@ -52,7 +54,7 @@ __all__ = [
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "LimitSurface",
-    "analysis", "batch", "BatchSummary", "set_threads",
+    "analysis", "batch", "BatchSummary", "set_threads", "MultiresDetails", "fit", "FitResult",
 ]
 
 

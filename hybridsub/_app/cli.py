@@ -1,4 +1,4 @@
-"""Command line: ``hybridsub subdivide | batch | compare | info | demo``.
+"""Command line: ``hybridsub subdivide | batch | compare | info | demo | fit | decompose``.
 
 Messages go to stderr (``--quiet`` silences all but errors), ``info`` writes its report to
 stdout. Exit codes: 0 success, 1 the input or the run failed (one line naming the problem),
@@ -360,7 +360,7 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--threads", type=_positive, metavar="N",
                     help="threads for the kernels (default: every core); the output does not depend on it")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo):
+    for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo, _add_fit, _add_decompose):
         add(sub)
     return ap
 
@@ -462,6 +462,56 @@ def _add_demo(sub) -> None:
     d.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     d.add_argument("-q", "--quiet", action="store_true", help="only the list of files written")
     d.set_defaults(func=cmd_demo)
+
+
+# ----------------------------------------------------------------------------------------------
+# fit and decompose (issue 15): the work is in _app/fitting.py
+
+
+def cmd_fit(a) -> int:
+    from .fitting import fit_file
+
+    return fit_file(a.control, a.target, a.output, levels=a.levels, scheme=a.scheme, smoothness=a.smoothness,
+                    max_iterations=a.max_iterations, tol=a.tol, quiet=a.quiet)
+
+
+def cmd_decompose(a) -> int:
+    from .fitting import decompose_file
+
+    return decompose_file(a.coarse, a.fine, a.output, levels=a.levels, scheme=a.scheme, quiet=a.quiet)
+
+
+def _add_fit(sub) -> None:
+    f = sub.add_parser("fit", help="fit a control mesh's subdivision surface to points (a scan, a dense mesh)",
+                       description="Fit the control positions of CONTROL (its connectivity and tags kept) so that "
+                                   "its limit surface, or its level-L mesh with --levels, is closest to the "
+                                   "points of TARGET (a mesh's vertices, or .xyz/.txt/.csv/.npy points). "
+                                   "Writes the fitted control mesh with its tags. See docs/fitting.md.")
+    f.add_argument("control", help="control mesh with its tags (its positions are the start)")
+    f.add_argument("target", help="target points: a mesh file or a point file")
+    f.add_argument("-o", "--output", required=True, help="fitted control mesh (OBJ, PLY, NPZ keep the tags)")
+    f.add_argument("--levels", type=_levels, default=None, help="fit the level-L mesh (default: the limit surface)")
+    f.add_argument("--scheme", choices=SCHEMES, default="hybrid")
+    f.add_argument("--smoothness", type=float, default=0.0, help="fairness weight (default 0)")
+    f.add_argument("--max-iterations", type=int, default=50)
+    f.add_argument("--tol", type=float, default=1e-12)
+    f.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    f.set_defaults(func=cmd_fit)
+
+
+def _add_decompose(sub) -> None:
+    d = sub.add_parser("decompose", help="reverse subdivision: coarse positions and details of a refined mesh",
+                       description="FINE is level L of COARSE's refinement (same numbering, e.g. written by "
+                                   "`hybridsub subdivide`, then edited). Writes COARSE's mesh with the "
+                                   "least-squares coarse positions to OUTPUT and the details (local frames) to "
+                                   "OUTPUT's stem + .details.npz. See docs/fitting.md.")
+    d.add_argument("coarse", help="the coarse mesh with its tags")
+    d.add_argument("fine", help="the refined (and edited) mesh")
+    d.add_argument("-o", "--output", required=True)
+    d.add_argument("--levels", type=_levels, required=True, help="levels between COARSE and FINE")
+    d.add_argument("--scheme", choices=SCHEMES, default="hybrid")
+    d.add_argument("-q", "--quiet", action="store_true")
+    d.set_defaults(func=cmd_decompose)
 
 
 def main(argv=None) -> int:

@@ -6,10 +6,13 @@ from .budget import (cgroup_memory_limit, get_memory_limit, memory_source, physi
                      set_memory_limit)
 from .facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from .fastpath import LevelOutput, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data
+from .fitting import FitResult, fit
 from .limit import LimitSurface, limit_matrix, limit_normals, limit_positions
+from .multires import MultiresDetails
 from .refinement import Refinement, RefinementStep, refine, refinement_of
 
-__all__ = ["FaceVaryingRefinement", "LevelOutput", "LimitSurface", "Refinement", "RefinementStep",
-           "cgroup_memory_limit", "get_memory_limit", "limit_matrix", "limit_normals", "limit_positions",
-           "memory_source", "physical_memory", "predict_levels", "refine", "refine_face_varying", "refinement_of", "seam_edges", "set_memory_limit",
-           "subdivide", "subdivide_face_varying", "subdivide_face_varying_levels", "subdivide_levels", "walk_data"]
+__all__ = ["FaceVaryingRefinement", "FitResult", "LevelOutput", "LimitSurface", "MultiresDetails", "Refinement",
+           "RefinementStep", "cgroup_memory_limit", "fit", "get_memory_limit", "limit_matrix", "limit_normals",
+           "limit_positions", "memory_source", "physical_memory", "predict_levels", "refine", "refine_face_varying",
+           "refinement_of", "seam_edges", "set_memory_limit", "subdivide", "subdivide_face_varying",
+           "subdivide_face_varying_levels", "subdivide_levels", "walk_data"]
