@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ._chart_kernels import place_corners
+
 #: The input faces' corners in their own frames: equilateral, unit sides.
 EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
 
@@ -156,19 +158,15 @@ def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.
     tw = twin[3 * parents[:, None] + np.arange(3)]
     g = np.where(tw >= 0, tw // 3, 0)
     nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
-    group_ids = np.concatenate([F[parents][:, None], nb_ids], axis=1)[pi]  # (m', 4, 3)
-    group_pos = np.concatenate([shape[parents][:, None], nb], axis=1)[pi]  # (m', 4, 3, 2)
-    ids = sup_ids[faces1]  # (m', 3 corners, 3 supports)
-    ws = sup_w[faces1]
-    match = ids[:, :, :, None, None] == group_ids[:, None, None]  # (m', 3, 3, 4, 3)
-    holds = (match.any(-1) | (ids < 0)[..., None]).all(axis=2)  # (m', 3, 4): group holds every support
-    if not holds.any(-1).all():  # pragma: no cover - the emission patterns guarantee it
+    group_ids = np.ascontiguousarray(np.concatenate([F[parents][:, None], nb_ids], axis=1), dtype=np.int64)
+    group_pos = np.ascontiguousarray(np.concatenate([shape[parents][:, None], nb], axis=1), dtype=np.float64)
+    out = np.empty((len(faces1), 3, 2))
+    ok = place_corners(np.ascontiguousarray(sup_ids[faces1], dtype=np.int64),
+                       np.ascontiguousarray(sup_w[faces1], dtype=np.float64),
+                       np.ascontiguousarray(pi, dtype=np.int64), group_ids, group_pos, out)
+    if not ok:  # pragma: no cover - the emission patterns guarantee it
         raise AssertionError("a child corner is not a combination of its parent's neighbourhood")
-    grp = holds.argmax(-1)  # (m', 3)
-    k = np.arange(len(faces1))
-    which = np.take_along_axis(match, grp[:, :, None, None, None], axis=3)[:, :, :, 0].argmax(-1)  # (m', 3, 3)
-    pos = group_pos[k[:, None, None], grp[:, :, None], which]  # (m', 3, 3, 2)
-    return (ws[..., None] * pos).sum(axis=2)
+    return out
 
 
 def _across(face, bary, twin0, tol):
