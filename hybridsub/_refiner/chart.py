@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._chart_kernels import place_corners
+from ._chart_kernels import glue_corners, place_corners
 
 #: The input faces' corners in their own frames: equilateral, unit sides.
 EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
@@ -154,7 +154,9 @@ def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.
     chart is not flat, and the same vertex glued through two neighbours lies in two places.
     """
     parents, pi = np.unique(parent, return_inverse=True)
-    nb = np.nan_to_num(glue(shape, twin, F, parents))  # (p, 3, 3, 2): neighbour i's corners, parent frame
+    nb = np.empty((len(parents), 3, 3, 2))  # neighbour i's corners in the parent's frame (0 on the boundary)
+    glue_corners(np.ascontiguousarray(shape, dtype=np.float64), np.ascontiguousarray(twin, dtype=np.int64),
+                 parents.astype(np.int64), nb)
     tw = twin[3 * parents[:, None] + np.arange(3)]
     g = np.where(tw >= 0, tw // 3, 0)
     nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
