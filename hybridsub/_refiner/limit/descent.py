@@ -26,6 +26,7 @@ from ..._input import RefineInput
 from ..._topology import Level, child_level, face_parents, plan_step
 from ..chart import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports
 from ..stencils import step_matrix
+from ._descent_kernels import ring_pairs
 from .local import refine_locally
 from .plan import plan_level
 
@@ -48,31 +49,9 @@ class Patches:
     uv: np.ndarray  # (k, 3, 2) that face's corners in the input face's (u, v)
 
 
-def _expand(node: np.ndarray, x: np.ndarray, ptr: np.ndarray, items: np.ndarray, size: int):
-    """(node, item) pairs for every item listed under each (node, x), without repeats, sorted."""
-    cnt = ptr[x + 1] - ptr[x]
-    nn = np.repeat(node, cnt)
-    start = np.repeat(ptr[x] - np.cumsum(cnt) + cnt, cnt)
-    it = items[start + np.arange(len(nn))]
-    key = np.unique(nn * size + it)
-    return key // size, key % size
-
-
 def ring_faces(F: np.ndarray, n: int, centre: np.ndarray, rings: int = RINGS):
     """(node, face) pairs: the faces within ``rings`` vertex rings of each node's centre face."""
-    m = len(F)
-    flat = F.ravel()
-    order = np.argsort(flat, kind="stable")
-    ptr = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=n))])
-    faces_of = order // 3
-    node = np.repeat(np.arange(len(centre)), 3)
-    v = F[centre].ravel()
-    for r in range(rings):
-        node, f = _expand(node, v, ptr, faces_of, m)
-        if r < rings - 1:
-            key = np.unique(np.repeat(node, 3) * n + F[f].ravel())
-            node, v = key // n, key % n
-    return node, f
+    return ring_pairs(np.ascontiguousarray(F, dtype=np.int64), int(n), np.asarray(centre, dtype=np.int64), rings)
 
 
 def cut_patches(level: Level, corner: np.ndarray, node: np.ndarray, f: np.ndarray):
