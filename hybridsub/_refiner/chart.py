@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._chart_kernels import glue_corners, place_corners
+from ._chart_kernels import child_corners
 
 #: The input faces' corners in their own frames: equilateral, unit sides.
 EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
@@ -153,19 +153,11 @@ def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.
     of those four faces that holds every support is used: around a vertex of low valence the
     chart is not flat, and the same vertex glued through two neighbours lies in two places.
     """
-    parents, pi = np.unique(parent, return_inverse=True)
-    nb = np.empty((len(parents), 3, 3, 2))  # neighbour i's corners in the parent's frame (0 on the boundary)
-    glue_corners(np.ascontiguousarray(shape, dtype=np.float64), np.ascontiguousarray(twin, dtype=np.int64),
-                 parents.astype(np.int64), nb)
-    tw = twin[3 * parents[:, None] + np.arange(3)]
-    g = np.where(tw >= 0, tw // 3, 0)
-    nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
-    group_ids = np.ascontiguousarray(np.concatenate([F[parents][:, None], nb_ids], axis=1), dtype=np.int64)
-    group_pos = np.ascontiguousarray(np.concatenate([shape[parents][:, None], nb], axis=1), dtype=np.float64)
     out = np.empty((len(faces1), 3, 2))
-    ok = place_corners(np.ascontiguousarray(sup_ids[faces1], dtype=np.int64),
-                       np.ascontiguousarray(sup_w[faces1], dtype=np.float64),
-                       np.ascontiguousarray(pi, dtype=np.int64), group_ids, group_pos, out)
+    ok = child_corners(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(twin, dtype=np.int64),
+                       np.ascontiguousarray(shape, dtype=np.float64), np.ascontiguousarray(faces1, dtype=np.int64),
+                       np.ascontiguousarray(parent, dtype=np.int64), np.ascontiguousarray(sup_ids, dtype=np.int64),
+                       np.ascontiguousarray(sup_w, dtype=np.float64), out)
     if not ok:  # pragma: no cover - the emission patterns guarantee it
         raise AssertionError("a child corner is not a combination of its parent's neighbourhood")
     return out

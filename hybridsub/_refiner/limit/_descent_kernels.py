@@ -79,3 +79,50 @@ def ring_pairs(F, n, centre, rings):
         out_n[size:size + nf] = i
         size += nf
     return out_n[:size], out_f[:size]
+
+
+@kernel
+def cut_pieces(F, twin, n, node, f):
+    """The faces ``f`` of each node (pairs sorted by node, then face) copied apart.
+
+    Returns the new faces (k, 3), the old vertex of every new vertex (numbered by node, then
+    old id) and the new halfedge twins (−1 where the neighbour is not in the same piece).
+    """
+    k = len(f)
+    vmark = np.full(n, -1, np.int64)
+    vnew = np.empty(n, np.int64)
+    fmark = np.full(len(F), -1, np.int64)
+    fnew = np.empty(len(F), np.int64)
+    newF = np.empty((k, 3), np.int64)
+    vsel = np.empty(3 * k, np.int64)
+    tw_out = np.empty(3 * k, np.int64)
+    nv = 0
+    a = 0
+    while a < k:
+        b = a
+        while b < k and node[b] == node[a]:
+            b += 1
+        i = node[a]
+        start = nv
+        for r in range(a, b):
+            fmark[f[r]] = i
+            fnew[f[r]] = r
+            for c in range(3):
+                v = F[f[r], c]
+                if vmark[v] != i:
+                    vmark[v] = i
+                    vsel[nv] = v
+                    nv += 1
+        vsel[start:nv] = np.sort(vsel[start:nv])
+        for j in range(start, nv):
+            vnew[vsel[j]] = j
+        for r in range(a, b):
+            for c in range(3):
+                newF[r, c] = vnew[F[f[r], c]]
+                t = twin[3 * f[r] + c]
+                if t >= 0 and fmark[t // 3] == i:
+                    tw_out[3 * r + c] = 3 * fnew[t // 3] + t % 3
+                else:
+                    tw_out[3 * r + c] = -1
+        a = b
+    return newF, vsel[:nv].copy(), tw_out

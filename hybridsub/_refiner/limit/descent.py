@@ -26,7 +26,7 @@ from ..._input import RefineInput
 from ..._topology import Level, child_level, face_parents, plan_step
 from ..chart import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports
 from ..stencils import step_matrix
-from ._descent_kernels import ring_pairs
+from ._descent_kernels import cut_pieces, ring_pairs
 from .local import refine_locally
 from .plan import plan_level
 
@@ -61,16 +61,11 @@ def cut_patches(level: Level, corner: np.ndarray, node: np.ndarray, f: np.ndarra
     vertices, and the sorted (node, face) keys (to find a face's new index).
     """
     n, m = level.n_vertices, level.n_faces
-    Fs = level.faces[f]
-    uniq, inv = np.unique(node[:, None] * n + Fs, return_inverse=True)
-    newF = inv.reshape(-1, 3).astype(np.int64)
-    vsel = uniq % n
+    newF, vsel, twin = cut_pieces(np.ascontiguousarray(level.faces, dtype=np.int64),
+                                  np.ascontiguousarray(level.twin, dtype=np.int64), int(n),
+                                  np.asarray(node, dtype=np.int64), np.asarray(f, dtype=np.int64))
+    uniq = vsel
     fkeys = node * m + f
-    tw = level.twin.reshape(-1, 3)[f]
-    k2 = node[:, None] * m + np.where(tw >= 0, tw // 3, 0)
-    pos = np.minimum(np.searchsorted(fkeys, k2), len(fkeys) - 1)
-    ok = (tw >= 0) & (fkeys[pos] == k2)
-    twin = np.where(ok, 3 * pos + tw % 3, -1).ravel()
     hs = None if level.hsharp is None else level.hsharp.reshape(-1, 3)[f].ravel()
     new = Level(newF, len(uniq), twin, hs, level.face_sharp[f])
     sel = sp.csr_matrix((np.ones(len(uniq)), vsel, np.arange(len(uniq) + 1)), shape=(len(uniq), n))
