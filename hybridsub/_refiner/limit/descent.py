@@ -96,7 +96,9 @@ def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
     ids = np.where((groups[..., None] >= 0) & (j < cnt[..., None]), first[..., None] + j, -1)  # (k, 4, 6)
     some, back = np.unique(np.maximum(ids, 0), return_inverse=True)
     corners = shapes_of(some)[back.reshape(ids.shape)]  # (k, 4, 6, 3, 2)
-    corners = np.einsum("kgab,kgjcb->kgjca", Rg, corners) + tg[:, :, None, None, :]
+    # Rg @ corner for every corner (einsum is several times slower on these shapes).
+    corners = Rg[:, :, None, None, :, 0] * corners[..., :1] + Rg[:, :, None, None, :, 1] * corners[..., 1:]
+    corners += tg[:, :, None, None, :]
     return ids.reshape(k, -1), corners.reshape(k, -1, 3, 2)
 
 
