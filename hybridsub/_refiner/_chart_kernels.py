@@ -93,3 +93,28 @@ def child_corners(F, twin, shape, faces1, parent, sup_ids, sup_w, out):
             out[k, c, 0] = x
             out[k, c, 1] = y
     return True
+
+
+@kernel
+def fill_supports(F, edge_point, trisected, face_point, ids, w):
+    """:func:`.chart.plan_supports` for the new vertices: ``ids``, ``w`` (n', 3) filled in
+    place (old vertices already set), halfedges in order (the last of an edge's two wins)."""
+    for h in range(len(edge_point)):
+        e = edge_point[h]
+        if e < 0:
+            continue
+        f, i = h // 3, h % 3
+        a, b = F[f, i], F[f, (i + 1) % 3]
+        ids[e, 0], ids[e, 1] = a, b
+        if trisected[f] == i:
+            w[e, 0], w[e, 1] = 2.0 / 3.0, 1.0 / 3.0
+            ids[e + 1, 0], ids[e + 1, 1] = a, b
+            w[e + 1, 0], w[e + 1, 1] = 1.0 / 3.0, 2.0 / 3.0
+        else:
+            w[e, 0], w[e, 1] = 0.5, 0.5
+    for f in range(len(face_point)):
+        p = face_point[f]
+        if p >= 0:
+            for c in range(3):
+                ids[p, c] = F[f, c]
+                w[p, c] = 1.0 / 3.0

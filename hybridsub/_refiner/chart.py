@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._chart_kernels import child_corners
+from ._chart_kernels import child_corners, fill_supports
 
 #: The input faces' corners in their own frames: equilateral, unit sides.
 EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
@@ -88,21 +88,9 @@ def plan_supports(F: np.ndarray, plan, n: int) -> tuple[np.ndarray, np.ndarray]:
     w = np.zeros((n1, 3))
     ids[:n, 0] = np.arange(n)
     w[:n, 0] = 1.0
-    fv = F.ravel()
-    h = np.flatnonzero(plan.edge_point >= 0)
-    nxt = 3 * (h // 3) + (h % 3 + 1) % 3
-    e = plan.edge_point[h]
-    tri = plan.trisected[h // 3] == h % 3
-    ids[e, 0], ids[e, 1] = fv[h], fv[nxt]
-    w[e, 0] = np.where(tri, 2.0 / 3.0, 0.5)
-    w[e, 1] = np.where(tri, 1.0 / 3.0, 0.5)
-    ht = h[tri]
-    e2 = plan.edge_point[ht] + 1
-    ids[e2, 0], ids[e2, 1] = fv[ht], fv[nxt[tri]]
-    w[e2, 0], w[e2, 1] = 1.0 / 3.0, 2.0 / 3.0
-    f = np.flatnonzero(plan.face_point >= 0)
-    ids[plan.face_point[f]] = F[f]
-    w[plan.face_point[f]] = 1.0 / 3.0
+    fill_supports(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(plan.edge_point, dtype=np.int64),
+                  np.ascontiguousarray(plan.trisected, dtype=np.int64),
+                  np.ascontiguousarray(plan.face_point, dtype=np.int64), ids, w)
     return ids, w
 
 
