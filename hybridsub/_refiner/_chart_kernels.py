@@ -27,8 +27,10 @@ def _glue_one(shape, twin, f, out):
         wx, wy = shape[f, (i + 1) % 3, 0], shape[f, (i + 1) % 3, 1]
         px, py = shape[g, (j + 1) % 3, 0], shape[g, (j + 1) % 3, 1]
         qx, qy = shape[g, j, 0], shape[g, j, 1]
-        a = math.atan2(wy - uy, wx - ux) - math.atan2(qy - py, qx - px)
-        c_, s_ = math.cos(a), math.sin(a)
+        # The rotation taking direction q - p onto w - u: cos and sin of the angle between them.
+        ax, ay, bx, by = qx - px, qy - py, wx - ux, wy - uy
+        r = 1.0 / math.sqrt((ax * ax + ay * ay) * (bx * bx + by * by))
+        c_, s_ = (ax * bx + ay * by) * r, (ax * by - ay * bx) * r
         tx = ux - (c_ * px - s_ * py)
         ty = uy - (s_ * px + c_ * py)
         for c in range(3):
