@@ -57,25 +57,24 @@ def ring_faces(F: np.ndarray, n: int, centre: np.ndarray, rings: int = RINGS):
 def cut_patches(level: Level, corner: np.ndarray, node: np.ndarray, f: np.ndarray):
     """The faces ``f`` of each node as a new mesh of disjoint pieces.
 
-    Returns the new :class:`Level`, its corner mask, the selection (n_new × n) from the old
-    vertices, and the sorted (node, face) keys (to find a face's new index).
+    Returns the new :class:`Level`, its corner mask, the old vertex of every new vertex, and
+    the sorted (node, face) keys (to find a face's new index).
     """
     n, m = level.n_vertices, level.n_faces
     newF, vsel, twin = cut_pieces(np.ascontiguousarray(level.faces, dtype=np.int64),
                                   np.ascontiguousarray(level.twin, dtype=np.int64), int(n),
                                   np.asarray(node, dtype=np.int64), np.asarray(f, dtype=np.int64))
-    uniq = vsel
     fkeys = node * m + f
     hs = None if level.hsharp is None else level.hsharp.reshape(-1, 3)[f].ravel()
-    new = Level(newF, len(uniq), twin, hs, level.face_sharp[f])
-    sel = sp.csr_matrix((np.ones(len(uniq)), vsel, np.arange(len(uniq) + 1)), shape=(len(uniq), n))
-    return new, corner[vsel], sel, fkeys
+    new = Level(newF, len(vsel), twin, hs, level.face_sharp[f])
+    return new, corner[vsel], vsel, fkeys
 
 
 def start(inp: RefineInput, faces0: np.ndarray):
     """Level-0 patches around the input faces ``faces0`` (one node each) and their selection."""
     node, f = ring_faces(inp.level.faces, inp.n_vertices, faces0)
-    level, corner, sel, fkeys = cut_patches(inp.level, inp.corner, node, f)
+    level, corner, vsel, fkeys = cut_patches(inp.level, inp.corner, node, f)
+    sel = sp.csr_matrix((np.ones(len(vsel)), vsel, np.arange(len(vsel) + 1)), shape=(len(vsel), inp.n_vertices))
     cur = np.searchsorted(fkeys, np.arange(len(faces0)) * inp.n_faces + faces0)
     shape = np.repeat(EQUILATERAL[None], level.n_faces, axis=0)
     uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(faces0), axis=0)
@@ -130,11 +129,11 @@ def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weig
     uv = lam @ p.uv[qnode[first]]
     corner1 = np.concatenate([p.corner, np.zeros(plan.n_new - lvl.n_vertices, bool)])
     node, f = ring_faces(faces1, plan.n_new, centre)
-    nxt, corner_n, sel, fkeys = cut_patches(child, corner1, node, f)
+    nxt, corner_n, vsel, fkeys = cut_patches(child, corner1, node, f)
     cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
     used, back = np.unique(f, return_inverse=True)
     shape_n = shapes_of(used)[back]
-    return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(sel @ S), qn.ravel(), nb
+    return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(S)[vsel], qn.ravel(), nb
 
 
 def _edge_tags(level: Level, scheme: str):
