@@ -1,10 +1,14 @@
 #!/usr/bin/env python
 """Side-by-side timings of hybridsub and every installed peer, as one Markdown report.
 
-usage: python benchmarks/compare.py [--quick] [--repeat N] [--budget S] [--markdown OUT.md]
+usage: python benchmarks/compare.py [--quick] [--repeat N] [--budget S] [--rounds R] [--markdown OUT.md]
                                     [--json OUT.json] [--no-build]
 
 What it measures (all in this one run, on this machine; see docs/performance.md):
+* per core, then with all cores (benchmarks/per_core.py, interleaved rounds): one animation
+  frame through the composite against OpenSubdiv's ``StencilTable::UpdateValues``, forming
+  the composite against ``StencilTableFactory::Create``, Loop and √3 against OpenSubdiv and
+  CGAL;
 * the rows of issue 3's target table: hybridsub against CGAL (√3, Loop), OpenSubdiv (Loop,
   Loop with creases), libigl, trimesh, VTK (pyvista), PyMeshLab, Open3D and gpytoolbox, on
   armadillo (52k faces) and fandisk (30° creases), 3 levels (2 with --quick);
@@ -40,6 +44,7 @@ from typing import Callable
 import numpy as np
 
 from _bench import FIRST_CALL, HERE, ROOT, Timing, child_env, cpu_name, fresh_process, load, measure, tags  # noqa: E402
+import per_core  # noqa: E402
 
 import hybridsub  # noqa: E402  (_bench put this checkout's package first)
 from hybridsub._io import read_off  # noqa: E402
@@ -165,7 +170,7 @@ def build_cxx(skipped: dict, rebuild: bool) -> dict:
         if r.returncode and r.stderr:
             print(r.stderr[-2000:], file=sys.stderr)
     found = {}
-    for name in ("cgal_subdiv", "osd_loop"):
+    for name in ("cgal_subdiv", "osd_loop", "osd_stencils"):
         exe = os.path.join(PEERS, "bin", name)
         if name in skipped:  # the build skipped or failed it: an old binary is not used
             continue
@@ -538,10 +543,25 @@ class Run:
         ]
         return rows
 
-    def report(self, apply_rows, floor_rows, starts, mem_rows) -> str:
+    def per_core(self) -> list:
+        """Issue 18's tables (benchmarks/per_core.py): per core first, then all cores."""
+        needed = ("osd_stencils", "osd_loop", "cgal_subdiv")
+        if any(not os.access(os.path.join(PEERS, "bin", n), os.X_OK) for n in needed):
+            self.skipped["per core"] = "needs osd_stencils, osd_loop and cgal_subdiv built"
+            return []
+        try:
+            check = per_core.check_stencils()
+            T = per_core.collect(self.args.rounds, 2 if self.args.quick else 3, self.L, log)
+        except Exception as e:
+            self.skipped["per core"] = f"failed: {e}"
+            return []
+        return ["## Per core, then all cores (issue 18)", ""] + per_core.report(T, check, self.L) + [""]
+
+    def report(self, apply_rows, floor_rows, starts, mem_rows, core_rows=()) -> str:
         L, T = self.L, self.T
         md = [f"# hybridsub performance — `benchmarks/compare.py`{' --quick' if self.args.quick else ''}", ""]
         md += machine_lines(self.args, self.versions, self.load_at_start) + [""]
+        md += list(core_rows)
 
         md += ["## Subdivision: ours against the peers", ""]
         md += table(["work", "ours median", "ours min", "peer", "peer median", "peer min", "ours / peer", "target", "",
@@ -609,11 +629,15 @@ def main(argv=None) -> int:
     ap.add_argument("--markdown", metavar="OUT.md", help="also write the report here")
     ap.add_argument("--json", metavar="OUT.json", help="write every raw timing here")
     ap.add_argument("--no-build", action="store_true", help="do not run peers/build.sh (use what is in peers/bin)")
+    ap.add_argument("--rounds", type=int, default=None, help="interleaved rounds of the per-core tables (default 3, "
+                    "--quick 1)")
     args = ap.parse_args(argv)
     args.repeat = args.repeat or (3 if args.quick else 7)
     args.budget = args.budget or (10.0 if args.quick else 60.0)
+    args.rounds = args.rounds or (1 if args.quick else 3)
 
     run = Run(args)
+    core_rows = run.per_core()  # first: the tables issue 18 reads, on the quietest part of the run
     run.time_ours()
     run.time_cxx()
     run.time_py_peers()
@@ -623,7 +647,7 @@ def main(argv=None) -> int:
     starts = first_calls(repeat=max(3, min(args.repeat, 5)), cold_runs=1 if args.quick else 2)
     mem_rows = run.memory()
 
-    text = run.report(apply_rows, floor_rows, starts, mem_rows)
+    text = run.report(apply_rows, floor_rows, starts, mem_rows, core_rows)
     print(text)
     if args.markdown:
         with open(args.markdown, "w") as fh:

@@ -28,6 +28,7 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr_
     from ._app.interop import subdivide_mesh
     from ._input import Features, detect_features
     from ._io import TaggedMesh, load_example, read_mesh, write_mesh
+    from ._jit import set_threads
     from ._refiner import (FaceVaryingRefinement, LimitSurface, Refinement, RefinementStep, get_memory_limit,
                            limit_matrix, limit_normals, limit_positions, refine, refine_face_varying, seam_edges,
                            set_memory_limit, subdivide, subdivide_face_varying)
@@ -41,6 +42,7 @@ _HOMES = {
     "._io": ("TaggedMesh", "load_example", "read_mesh", "write_mesh"),
     "._app.batch": ("BatchSummary", "batch"),
     "._app.interop": ("subdivide_mesh",),
+    "._jit": ("set_threads",),
 }
 _HOME_OF = {name: home for home, names in _HOMES.items() for name in names}
 _SUBMODULES = ("_app", "_io", "_refiner", "_input", "_topology", "_rules", "_jit", "_typing", "_units")
@@ -50,7 +52,7 @@ __all__ = [
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
     "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "LimitSurface",
-    "analysis", "batch", "BatchSummary",
+    "analysis", "batch", "BatchSummary", "set_threads",
 ]
 
 

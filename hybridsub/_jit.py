@@ -24,6 +24,8 @@ import re
 import sys
 import types
 
+import numba
+import numpy as np
 from numba import njit
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
 from numba.core.dispatcher import Dispatcher
@@ -66,6 +68,35 @@ def threaded_and_serial(fn):
     serial.__qualname__ = fn.__qualname__ + "_serial"
     serial.__doc__ = fn.__doc__
     return kernel(parallel=True)(fn), kernel(serial)
+
+
+def set_threads(n: int | None = None) -> int:
+    """Set how many threads the kernels use from now on; returns the number set.
+
+    ``n``: 1 runs everything on one core; None (default) goes back to every thread Numba
+    starts with (``NUMBA_NUM_THREADS``, by default one per core), the most ``n`` may be.
+    Results do not depend on it: every kernel sums each output in the same order whatever
+    the number of threads, so one thread and all give the same bits. Numba keeps the
+    setting per calling thread (a thread started later begins with all of them); the
+    command line's ``hybridsub --threads N`` sets it for the whole run.
+
+    Examples
+    --------
+    >>> import hybridsub
+    >>> hybridsub.set_threads(1)
+    1
+    >>> hybridsub.set_threads() >= 1
+    True
+    """
+    most = numba.config.NUMBA_NUM_THREADS
+    if n is None:
+        n = most
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+        raise TypeError(f"threads must be an integer or None, got {n!r}")
+    if not 1 <= n <= most:
+        raise ValueError(f"threads must be between 1 and {most} (NUMBA_NUM_THREADS), got {n}")
+    numba.set_num_threads(int(n))
+    return int(n)
 
 
 def dependencies(module: str) -> tuple[str, ...]:

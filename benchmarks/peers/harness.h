@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <time.h>
+
 namespace harness {
 
 // A triangle mesh as flat arrays, the layout hybridsub uses: V is n x 3, F is m x 3.
@@ -80,6 +82,14 @@ inline std::vector<int> read_pairs(const std::string& path) {
 inline double now() {
     using clock = std::chrono::steady_clock;
     return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+// CPU seconds of the whole process (all its threads): on a shared machine, a single-threaded
+// section's CPU time leaves out the time other processes held the core.
+inline double cpu_now() {
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 inline double median(std::vector<double> t) {

@@ -357,6 +357,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 success, 1 the input or the run failed, 2 bad command line. "
                f"Documentation (the guide and the API reference): {DOCS_URL}")
     ap.add_argument("--version", action="version", version=f"hybridsub {__version__}")
+    ap.add_argument("--threads", type=_positive, metavar="N",
+                    help="threads for the kernels (default: every core); the output does not depend on it")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo):
         add(sub)
@@ -468,6 +470,10 @@ def main(argv=None) -> int:
     from .pipeline import PipelineError  # after parsing: --help and usage errors load nothing heavy
 
     try:
+        if a.threads is not None:
+            from .._jit import set_threads
+
+            set_threads(a.threads)
         return a.func(a)
     except PipelineError as e:
         msg = str(e)

@@ -20,7 +20,7 @@ from .budget import Budget, check_product
 from .chart import vertex_origins
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
-from .stencils import apply_matrix, step_matrix
+from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, step_matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,13 +177,18 @@ class Refinement:
         face, bary = self._cache["origin"]
         return face.copy(), bary.copy()
 
-    def apply(self, X: ArrayLike) -> np.ndarray:
+    def apply(self, X: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """Refine per-vertex data: positions, UVs, colours, any (n_coarse, ...) array.
 
         Floating-point data keeps its dtype (computed in float64); other data comes back as
         float64; complex data stays complex. The result is always a new array, also with no
-        steps. The step matrices are applied one after the other, which is cheaper than the
-        composite when the matrix has not been formed.
+        steps, unless ``out`` is given: a C-contiguous float64 array of the result's shape
+        (real data only), written and returned — an animation reusing one buffer per frame
+        saves allocating (and the system's zeroing of) fresh memory every frame. Once ``matrix`` has been formed, ``apply`` multiplies by it (one pass over the
+        data, the product ``matrix @ X`` to the bit); before, by the step matrices one after the
+        other (``subdivide``'s result to the bit). Either is held with its distinct weights
+        stored once (a 2-byte code an entry, see ``docs/performance.md``), built on the first
+        call; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
 
         Examples
         --------
@@ -192,22 +197,51 @@ class Refinement:
         >>> r = hybridsub.refine(F, levels=1)
         >>> r.apply(V).shape
         (7, 3)
+        >>> buf = np.empty((7, 3)); r.apply(V, out=buf) is buf
+        True
         """
         A, out_dtype, work = as_data(X, self.n_coarse)  # dtypes, shapes, never a view
-        Y = np.asarray(A, dtype=work).reshape(self.n_coarse, int(np.prod(A.shape[1:], dtype=np.int64)))
+        k = int(np.prod(A.shape[1:], dtype=np.int64))
+        Y = np.asarray(A, dtype=work).reshape(self.n_coarse, k)
+        if out is not None:
+            dest = _output_buffer(out, (self.n_vertices,) + A.shape[1:], work)
+            if not self.steps:
+                dest[...] = Y
+            for i, S in enumerate(stencils := self._stencils()):
+                last = dest if i == len(stencils) - 1 else None
+                Y = apply_coded(S, Y, last) if isinstance(S, CodedStencils) else apply_matrix(S, Y, last)
+            return out
         if work == np.complex128:  # real and imaginary parts side by side
             Y = np.concatenate([Y.real, Y.imag], axis=1)
         if not self.steps:
             Y = Y.copy()
-        elif "matrix" in self._cache:
-            Y = apply_matrix(self._cache["matrix"], Y)
-        else:
-            for st in self.steps:
-                Y = apply_matrix(st.matrix, Y)
+        for S in self._stencils():
+            Y = apply_coded(S, Y) if isinstance(S, CodedStencils) else apply_matrix(S, Y)
         if work == np.complex128:
             k = Y.shape[1] // 2
             Y = Y[:, :k] + 1j * Y[:, k:]
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
+
+    def _stencils(self) -> list:
+        """What :meth:`apply` multiplies by, coded where the weights allow: the composite once
+        formed, else the steps. Built once each."""
+        key = "coded matrix" if "matrix" in self._cache else "coded steps"
+        if key not in self._cache:
+            mats = [self._cache["matrix"]] if key == "coded matrix" else [st.matrix for st in self.steps]
+            self._cache[key] = [coded_stencils(S) or S for S in mats]
+        return self._cache[key]
+
+
+def _output_buffer(out, shape: tuple, work) -> np.ndarray:
+    """``out`` of :meth:`Refinement.apply` as the (rows, k) array the last product writes."""
+    if not isinstance(out, np.ndarray) or out.dtype != np.float64 or not out.flags.c_contiguous \
+            or not out.flags.writeable:
+        raise TypeError("out must be a writeable C-contiguous float64 numpy array")
+    if out.shape != shape:
+        raise ValueError(f"out must have shape {shape}, got {out.shape}")
+    if work != np.float64:
+        raise TypeError("out is for real data; complex data needs a new array (call apply without out)")
+    return out.reshape(shape[0], -1)
 
 
 def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *, n_vertices: int | None = None,
