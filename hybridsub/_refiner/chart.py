@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ._chart_kernels import child_corners, fill_supports
+
 #: The input faces' corners in their own frames: equilateral, unit sides.
 EQUILATERAL = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
 
@@ -86,21 +88,9 @@ def plan_supports(F: np.ndarray, plan, n: int) -> tuple[np.ndarray, np.ndarray]:
     w = np.zeros((n1, 3))
     ids[:n, 0] = np.arange(n)
     w[:n, 0] = 1.0
-    fv = F.ravel()
-    h = np.flatnonzero(plan.edge_point >= 0)
-    nxt = 3 * (h // 3) + (h % 3 + 1) % 3
-    e = plan.edge_point[h]
-    tri = plan.trisected[h // 3] == h % 3
-    ids[e, 0], ids[e, 1] = fv[h], fv[nxt]
-    w[e, 0] = np.where(tri, 2.0 / 3.0, 0.5)
-    w[e, 1] = np.where(tri, 1.0 / 3.0, 0.5)
-    ht = h[tri]
-    e2 = plan.edge_point[ht] + 1
-    ids[e2, 0], ids[e2, 1] = fv[ht], fv[nxt[tri]]
-    w[e2, 0], w[e2, 1] = 1.0 / 3.0, 2.0 / 3.0
-    f = np.flatnonzero(plan.face_point >= 0)
-    ids[plan.face_point[f]] = F[f]
-    w[plan.face_point[f]] = 1.0 / 3.0
+    fill_supports(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(plan.edge_point, dtype=np.int64),
+                  np.ascontiguousarray(plan.trisected, dtype=np.int64),
+                  np.ascontiguousarray(plan.face_point, dtype=np.int64), ids, w)
     return ids, w
 
 
@@ -151,24 +141,14 @@ def child_shapes(F: np.ndarray, twin: np.ndarray, shape: np.ndarray, faces1: np.
     of those four faces that holds every support is used: around a vertex of low valence the
     chart is not flat, and the same vertex glued through two neighbours lies in two places.
     """
-    parents, pi = np.unique(parent, return_inverse=True)
-    nb = np.nan_to_num(glue(shape, twin, F, parents))  # (p, 3, 3, 2): neighbour i's corners, parent frame
-    tw = twin[3 * parents[:, None] + np.arange(3)]
-    g = np.where(tw >= 0, tw // 3, 0)
-    nb_ids = np.where((tw >= 0)[..., None], F[g], -2)  # (p, 3, 3); −2 matches nothing
-    group_ids = np.concatenate([F[parents][:, None], nb_ids], axis=1)[pi]  # (m', 4, 3)
-    group_pos = np.concatenate([shape[parents][:, None], nb], axis=1)[pi]  # (m', 4, 3, 2)
-    ids = sup_ids[faces1]  # (m', 3 corners, 3 supports)
-    ws = sup_w[faces1]
-    match = ids[:, :, :, None, None] == group_ids[:, None, None]  # (m', 3, 3, 4, 3)
-    holds = (match.any(-1) | (ids < 0)[..., None]).all(axis=2)  # (m', 3, 4): group holds every support
-    if not holds.any(-1).all():  # pragma: no cover - the emission patterns guarantee it
+    out = np.empty((len(faces1), 3, 2))
+    ok = child_corners(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(twin, dtype=np.int64),
+                       np.ascontiguousarray(shape, dtype=np.float64), np.ascontiguousarray(faces1, dtype=np.int64),
+                       np.ascontiguousarray(parent, dtype=np.int64), np.ascontiguousarray(sup_ids, dtype=np.int64),
+                       np.ascontiguousarray(sup_w, dtype=np.float64), out)
+    if not ok:  # pragma: no cover - the emission patterns guarantee it
         raise AssertionError("a child corner is not a combination of its parent's neighbourhood")
-    grp = holds.argmax(-1)  # (m', 3)
-    k = np.arange(len(faces1))
-    which = np.take_along_axis(match, grp[:, :, None, None, None], axis=3)[:, :, :, 0].argmax(-1)  # (m', 3, 3)
-    pos = group_pos[k[:, None, None], grp[:, :, None], which]  # (m', 3, 3, 2)
-    return (ws[..., None] * pos).sum(axis=2)
+    return out
 
 
 def _across(face, bary, twin0, tol):

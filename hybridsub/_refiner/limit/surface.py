@@ -121,13 +121,13 @@ class LimitSurface:
         L = D.limit_rows(p, needed, inp.scheme, inp.loop_weights, self._tol, self._max_levels)
         q = len(f)
         n = p.level.n_vertices
-        out = []
-        for W in weights[:[1, 3, 6][int(derivatives)]]:
-            R = sp.csr_matrix((W.ravel(), ids.ravel(), np.arange(0, 6 * q + 1, 6)), shape=(q, n)) @ L
-            for A in reversed(maps):
-                R = R @ A
-            out.append(sp.csr_matrix(R))
-        return out
+        k = [1, 3, 6][int(derivatives)]
+        W = np.concatenate([w.ravel() for w in weights[:k]])
+        R = sp.csr_matrix((W, np.tile(ids.ravel(), k), np.arange(0, 6 * k * q + 1, 6)), shape=(k * q, n)) @ L
+        for A in reversed(maps):  # all rows (value, derivatives) through the levels at once
+            R = R @ A
+        R = sp.csr_matrix(R)
+        return [R[i * q:(i + 1) * q] for i in range(k)]
 
     def evaluation_matrix(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False):
         """The sparse rows that give the limit surface at the points: ``evaluate == M @ V``.
