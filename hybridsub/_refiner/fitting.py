@@ -347,6 +347,7 @@ def _iterate(surface, V, pts, smooth, max_iterations, tol, callback) -> FitResul
     diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) or 1.0
     solver = Solver()
     rows, converged, it, energy, halvings = [], False, 0, np.inf, 0
+    dx = V_prev = V  # (set by the first update; the first pass neither halves nor compares)
     while True:
         feet = surface.feet(V, pts)
         d = feet.distance
