@@ -909,7 +909,8 @@ def test_rerun_memory_does_not_grow_with_inputs(tmp_path):
         peaks.append(tracemalloc.get_traced_memory()[1])
         tracemalloc.stop()
         assert (s.total, s.skipped) == (n, n)
-    assert peaks[1] < peaks[0] + 100 * 1800, peaks  # < 0.1 kB per extra input
+    # flat once a few planning chunks (512 inputs) are in flight; the JSON-lines manifest took 7.4 kB per input
+    assert peaks[1] < 1024 * 2400 and peaks[1] - peaks[0] < 400 * 1800, peaks
 
 
 def test_dask_logs_held_back_while_a_batch_runs(capfd):
