@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ._closest_kernels import closest_among
 
@@ -97,6 +96,8 @@ class ClosestPoints:
         todo = np.flatnonzero(self.kth - self.drift - rho < np.sqrt(d2))
         if len(todo):
             owner, sample = _samples(tri, self.split)
+            from scipy.spatial import cKDTree  # (imported when used: it costs start-up time)
+
             tree = cKDTree(sample)
         k = self.k
         while len(todo):

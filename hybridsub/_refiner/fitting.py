@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .._errors import MeshError
 from .._input import as_vertices
@@ -86,6 +85,8 @@ class Solver:
         self.factorizations = 0
 
     def solve(self, H: sp.csc_matrix, b: np.ndarray) -> np.ndarray:
+        import scipy.sparse.linalg as spla  # (imported when used: it costs start-up time)
+
         if self.factor is not None:
             pre = spla.LinearOperator(H.shape, matvec=self.factor.solve, dtype=np.float64)
             x, info = spla.cg(H, b, rtol=_CG_RTOL, atol=0.0, maxiter=_CG_MAXITER, M=pre)

@@ -20,7 +20,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .._errors import MeshError
 from .._input import as_data
@@ -150,6 +149,8 @@ def _solve(cache: dict, k: int, S: sp.csr_matrix, Y: np.ndarray) -> np.ndarray:
     if key not in cache:
         StS = sp.csc_matrix(S.T @ S)
         try:
+            import scipy.sparse.linalg as spla  # (imported when used: it costs start-up time)
+
             cache[key] = spla.splu(StS, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                                    options={"SymmetricMode": True})
         except RuntimeError:

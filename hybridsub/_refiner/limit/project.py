@@ -6,7 +6,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..._input import RefineInput
 from ..chart import onto_input_faces
@@ -122,6 +121,8 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     M, sf, sb = surface._seed_setup()
     S = M @ X
     k = min(SEEDS, len(S))
+    from scipy.spatial import cKDTree  # (imported when used: it costs start-up time)
+
     _, near = cKDTree(S).query(pts, k=k)
     near = near.reshape(len(pts), k).ravel()
     many = np.repeat(pts, k, axis=0)
