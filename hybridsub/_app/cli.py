@@ -322,10 +322,14 @@ def _uv_option(p) -> None:
                         "the texture undistorted; smooth subdivides them like the positions")
 
 
+def _scheme_option(p) -> None:
+    p.add_argument("--scheme", choices=SCHEMES, default="hybrid",
+                   help="hybrid (default): √3 on smooth faces, Loop on sharp ones; sqrt3: Kobbelt; loop")
+
+
 def _tag_options(p, *, scheme=True, input_opts=True, tag_files=True) -> None:
     if scheme:
-        p.add_argument("--scheme", choices=SCHEMES, default="hybrid",
-                       help="hybrid (default): √3 on smooth faces, Loop on sharp ones; sqrt3: Kobbelt; loop")
+        _scheme_option(p)
     g = p.add_argument_group("features (merged when several are given)")
     g.add_argument("--feature-angle", type=_angle, metavar="DEG",
                    help="tag edges whose dihedral angle exceeds DEG degrees as creases")
@@ -491,7 +495,7 @@ def _add_fit(sub) -> None:
     f.add_argument("target", help="target points: a mesh file or a point file")
     f.add_argument("-o", "--output", required=True, help="fitted control mesh (OBJ, PLY, NPZ keep the tags)")
     f.add_argument("--levels", type=_levels, default=None, help="fit the level-L mesh (default: the limit surface)")
-    f.add_argument("--scheme", choices=SCHEMES, default="hybrid")
+    _scheme_option(f)
     f.add_argument("--smoothness", type=float, default=0.0, help="fairness weight (default 0)")
     f.add_argument("--max-iterations", type=int, default=50)
     f.add_argument("--tol", type=float, default=1e-12)
@@ -509,7 +513,7 @@ def _add_decompose(sub) -> None:
     d.add_argument("fine", help="the refined (and edited) mesh")
     d.add_argument("-o", "--output", required=True)
     d.add_argument("--levels", type=_levels, required=True, help="levels between COARSE and FINE")
-    d.add_argument("--scheme", choices=SCHEMES, default="hybrid")
+    _scheme_option(d)
     d.add_argument("-q", "--quiet", action="store_true")
     d.set_defaults(func=cmd_decompose)
 

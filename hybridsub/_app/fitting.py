@@ -43,15 +43,10 @@ def fit_file(control: str, target: str, output: str, *, levels=None, scheme="hyb
     say = (lambda *m: None) if quiet else (lambda *m: print(*m, file=sys.stderr, flush=True))
     what = "the limit surface" if levels is None else f"level {levels}"
     say(f"fitting {what} of {control} ({len(mesh.faces):,} faces, {scheme}) to {len(pts):,} points of {target}")
-    tags = dict(sharpness=mesh.sharpness if len(mesh.sharp_edges) else None,
-                corners=mesh.corners if len(mesh.corners) else None,
-                sharp_faces=mesh.sharp_faces if len(mesh.sharp_faces) else None)
-    sharp = mesh.sharp_edges if len(mesh.sharp_edges) else None
-    res = fit(mesh.faces, pts, sharp, scheme=scheme, V0=mesh.vertices, levels=levels, smoothness=smoothness,
-              max_iterations=max_iterations, tol=tol, **tags,
+    res = fit(mesh.faces, pts, scheme=scheme, V0=mesh.vertices, levels=levels, smoothness=smoothness,
+              max_iterations=max_iterations, tol=tol, **mesh.tag_arrays(),
               callback=lambda i, rms, mx: say(f"  iteration {i:3d}: rms {rms:.6g}, max {mx:.6g}"))
-    _io.write_mesh(output, res.vertices, mesh.faces, sharp_edges=mesh.sharp_edges, sharpness=mesh.sharpness,
-                   corners=mesh.corners, sharp_faces=mesh.sharp_faces)
+    _io.write_mesh(output, res.vertices, mesh.faces, **mesh.tag_arrays())
     state = "converged" if res.converged else "stopped (max iterations)"
     say(f"{state} after {res.iterations} updates: rms {res.rms:.6g}, max {res.max_error:.6g}; wrote {output}")
     return 0
@@ -62,16 +57,12 @@ def decompose_file(coarse: str, fine: str, output: str, *, levels: int, scheme="
     (the coarse mesh, new positions, tags kept) and ``output``'s stem + ``.details.npz``."""
     cm = _io.read_mesh(coarse)
     fm = _io.read_mesh(fine)
-    r = refine(cm.faces, cm.sharp_edges if len(cm.sharp_edges) else None, levels, n_vertices=len(cm.vertices),
-               scheme=scheme, sharpness=cm.sharpness if len(cm.sharp_edges) else None,
-               corners=cm.corners if len(cm.corners) else None,
-               sharp_faces=cm.sharp_faces if len(cm.sharp_faces) else None)
+    r = refine(cm.faces, levels=levels, n_vertices=len(cm.vertices), scheme=scheme, **cm.tag_arrays())
     if len(fm.vertices) != r.n_vertices:
         raise ValueError(f"{fine}: has {len(fm.vertices):,} vertices, level {levels} of {coarse} has "
                          f"{r.n_vertices:,}: the fine mesh must be that refinement (same numbering)")
     c, details = r.decompose(fm.vertices)
-    _io.write_mesh(output, c, cm.faces, sharp_edges=cm.sharp_edges, sharpness=cm.sharpness, corners=cm.corners,
-                   sharp_faces=cm.sharp_faces)
+    _io.write_mesh(output, c, cm.faces, **cm.tag_arrays())
     side = os.path.splitext(output)[0] + ".details.npz"
     np.savez_compressed(side, **{f"level{k + 1}": d for k, d in enumerate(details)},
                         local_frames=details.local_frames)
