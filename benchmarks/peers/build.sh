@@ -30,7 +30,7 @@ build() {  # build NAME HEADER LIBS...
         echo "skip $name: <$header> not found (apt-get install ${pkg[$name]})"
         return
     fi
-    if [ $force = 0 ] && [ -x "$out" ] && [ "$out" -nt "$src" ] && [ "$out" -nt "$here/harness.h" ]; then
+    if [ $force = 0 ] && [ -x "$out" ] && [ "$out" -nt "$src" ] && [ "$out" -nt "$here/harness.h" ] && [ "$out" -nt "$here/osd_common.h" ]; then
         echo "ok   $name (up to date)"
         return
     fi

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "harness.h"
+#include "osd_common.h"
 
 using namespace OpenSubdiv;
 
@@ -49,22 +50,7 @@ int main(int argc, char** argv) try {
     const int repeat = std::stoi(args.get("repeat", "3"));
     std::vector<int> creases;
     if (!args.get("creases").empty()) creases = harness::read_pairs(args.get("creases"));
-    const std::vector<float> sharpness(creases.size() / 2, Sdc::Crease::SHARPNESS_INFINITE);
-    const std::vector<int> verts_per_face(mesh.n_faces(), 3);
-    Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.n_vertices();
-    desc.numFaces = mesh.n_faces();
-    desc.numVertsPerFace = verts_per_face.data();
-    desc.vertIndicesPerFace = mesh.F.data();
-    desc.numCreases = int(sharpness.size());
-    desc.creaseVertexIndexPairs = creases.data();
-    desc.creaseWeights = sharpness.data();
-    Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, Factory::Options(Sdc::SCHEME_LOOP, sdc)));
-    if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+    std::unique_ptr<Far::TopologyRefiner> refiner(osd_common::create_loop_refiner(mesh, creases));
 
     Bfr::RefinerSurfaceFactory<>::Options opts;
     if (!args.get("approx-smooth").empty()) opts.SetApproxLevelSmooth(std::stoi(args.get("approx-smooth")));

@@ -8,7 +8,8 @@
 // keeping only the previous level's buffer.
 //
 // Each repetition times, separately and in total:
-//   create       TopologyRefinerFactory::Create (the base level's topology, from the faces)
+//   create       TopologyRefinerFactory::Create (the base level's topology, from the faces;
+//                osd_common.h, with its descriptor)
 //   refine       RefineUniform(LEVELS)
 //   interpolate  allocating each level's positions and PrimvarRefiner::Interpolate
 // The refiner and buffers are destroyed (not timed) before the next repetition.
@@ -25,18 +26,11 @@
 #include <vector>
 
 #include "harness.h"
+#include "osd_common.h"
 
 using namespace OpenSubdiv;
 
-struct Point {
-    double p[3];
-    void Clear() { p[0] = p[1] = p[2] = 0.0; }
-    void AddWithWeight(const Point& s, double w) {
-        p[0] += w * s.p[0];
-        p[1] += w * s.p[1];
-        p[2] += w * s.p[2];
-    }
-};
+using Point = osd_common::Point<double>;
 
 #define STR2(x) #x
 #define STR(x) STR2(x)
@@ -54,24 +48,6 @@ int main(int argc, char** argv) try {
     if (levels < 1 || levels > 15) throw std::runtime_error("LEVELS must be in 1..15");
     std::vector<int> creases;
     if (!args.get("creases").empty()) creases = harness::read_pairs(args.get("creases"));
-    const std::vector<float> sharpness(creases.size() / 2, Sdc::Crease::SHARPNESS_INFINITE);
-    const std::vector<int> verts_per_face(mesh.n_faces(), 3);
-
-    Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.n_vertices();
-    desc.numFaces = mesh.n_faces();
-    desc.numVertsPerFace = verts_per_face.data();
-    desc.vertIndicesPerFace = mesh.F.data();
-    desc.numCreases = int(sharpness.size());
-    desc.creaseVertexIndexPairs = creases.data();
-    desc.creaseWeights = sharpness.data();
-
-    Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    const Factory::Options options(Sdc::SCHEME_LOOP, sdc);
-
     const std::vector<Point> coarse(reinterpret_cast<const Point*>(mesh.V.data()),
                                     reinterpret_cast<const Point*>(mesh.V.data()) + mesh.n_vertices());
     std::vector<double> t_create, t_refine, t_interp, t_total;
@@ -83,8 +59,7 @@ int main(int argc, char** argv) try {
         double t0 = 0, t1 = 0, t2 = 0, t3 = 0;
         auto timed = [&] {
             t0 = harness::now();
-            refiner.reset(Factory::Create(desc, options));
-            if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+            refiner.reset(osd_common::create_loop_refiner(mesh, creases));
             t1 = harness::now();
             refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(levels));
             t2 = harness::now();
@@ -121,7 +96,7 @@ int main(int argc, char** argv) try {
     std::printf("{\"peer\": \"OpenSubdiv %d.%d.%d Far Loop\", \"scheme\": \"loop\", \"levels\": %d, \"repeat\": %d, "
                 "\"n_creases\": %zu, \"n_vertices\": %ld, \"n_faces\": %ld, \"peak_rss_delta\": %ld, %s, %s, %s, %s}\n",
                 OPENSUBDIV_VERSION_MAJOR, OPENSUBDIV_VERSION_MINOR, OPENSUBDIV_VERSION_PATCH, levels, repeat,
-                sharpness.size(), nv, nf, peak, harness::json_timing("subdivide", t_total).c_str(),
+                creases.size() / 2, nv, nf, peak, harness::json_timing("subdivide", t_total).c_str(),
                 harness::json_timing("create", t_create).c_str(), harness::json_timing("refine", t_refine).c_str(),
                 harness::json_timing("interpolate", t_interp).c_str());
     return 0;

@@ -2,7 +2,7 @@
 //
 // usage: osd_stencils MESH.off LEVELS [--repeat N] [--warmup W] [--threads T] [--out RESULT.off]
 //
-// Loop scheme, VTX_BOUNDARY_EDGE_ONLY (the options of osd_loop.cpp). Each repetition times:
+// Loop scheme with the options of osd_loop.cpp (osd_common.h), no creases. Each repetition times:
 //   refine        TopologyRefinerFactory::Create + RefineUniform(LEVELS)
 //   stencils      StencilTableFactory::Create, last level only, factorized onto the control
 //                 vertices (generateIntermediateLevels = false), float weights
@@ -30,19 +30,12 @@
 #include <vector>
 
 #include "harness.h"
+#include "osd_common.h"
 
 using namespace OpenSubdiv;
 
 template <typename REAL>
-struct Point {
-    REAL p[3];
-    void Clear() { p[0] = p[1] = p[2] = 0; }
-    void AddWithWeight(const Point& s, REAL w) {
-        p[0] += w * s.p[0];
-        p[1] += w * s.p[1];
-        p[2] += w * s.p[2];
-    }
-};
+using Point = osd_common::Point<REAL>;
 
 #define STR2(x) #x
 #define STR(x) STR2(x)
@@ -60,18 +53,6 @@ int main(int argc, char** argv) try {
     const int threads = std::stoi(args.get("threads", "0"));
     if (levels < 1 || levels > 10) throw std::runtime_error("LEVELS must be in 1..10");
     if (threads > 0) omp_set_num_threads(threads);
-    const std::vector<int> verts_per_face(mesh.n_faces(), 3);
-
-    Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.n_vertices();
-    desc.numFaces = mesh.n_faces();
-    desc.numVertsPerFace = verts_per_face.data();
-    desc.vertIndicesPerFace = mesh.F.data();
-    Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    const Factory::Options options(Sdc::SCHEME_LOOP, sdc);
-
     const int n = mesh.n_vertices();
     std::vector<Point<float>> src_f(n);
     std::vector<Point<double>> src_d(n);
@@ -84,8 +65,7 @@ int main(int argc, char** argv) try {
     long nv = 0, nf = 0, nnz = 0;
     for (int r = 0; r < warmup + repeat; ++r) {
         const double t0 = harness::now();
-        std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, options));
-        if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+        std::unique_ptr<Far::TopologyRefiner> refiner(osd_common::create_loop_refiner(mesh, {}));
         refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(levels));
         const double t1 = harness::now(), c1 = harness::cpu_now();
         Far::StencilTableFactory::Options so;
