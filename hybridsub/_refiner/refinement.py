@@ -185,11 +185,12 @@ class Refinement:
         float64; complex data stays complex. The result is always a new array, also with no
         steps, unless ``out`` is given: a C-contiguous float64 array of the result's shape
         (real data only), written and returned — an animation reusing one buffer per frame
-        saves allocating (and the system's zeroing of) fresh memory every frame. Once ``matrix`` has been formed, ``apply`` multiplies by it (one pass over the
-        data, the product ``matrix @ X`` to the bit); before, by the step matrices one after the
-        other (``subdivide``'s result to the bit). Either is held with its distinct weights
-        stored once (a 2-byte code an entry, see ``docs/performance.md``), built on the first
-        call; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
+        saves allocating (and the system's zeroing of) fresh memory every frame. Once ``matrix``
+        has been formed, ``apply`` multiplies by it (one pass over the data, the product
+        ``matrix @ X`` to the bit); before, by the step matrices one after the other
+        (``subdivide``'s result to the bit). From the second call on, either is held with its
+        distinct weights stored once (a 2-byte code an entry, see ``docs/performance.md``), the
+        same bits faster; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
 
         Examples
         --------
@@ -224,14 +225,17 @@ class Refinement:
         return np.ascontiguousarray(Y.reshape((Y.shape[0],) + A.shape[1:]), dtype=out_dtype)
 
     def _stencils(self) -> list:
-        """What :meth:`apply` multiplies by, coded where the weights allow: the composite once
-        formed, else the steps. Built once each."""
+        """What :meth:`apply` multiplies by: the composite once formed, else the steps; from the
+        second call on, coded where the weights allow (coding costs a few frames, so data
+        refined once is multiplied by the plain matrices, with the same bits)."""
         key = "coded matrix" if "matrix" in self._cache else "coded steps"
+        mats = [self._cache["matrix"]] if key == "coded matrix" else [st.matrix for st in self.steps]
         if key not in self._cache:
-            mats = [self._cache["matrix"]] if key == "coded matrix" else [st.matrix for st in self.steps]
+            if not self._cache.pop("uncoded " + key, False):
+                self._cache["uncoded " + key] = True
+                return mats
             self._cache[key] = [coded_stencils(S) or S for S in mats]
         return self._cache[key]
-
 
     def decompose(self, X: ArrayLike, *, frames: bool | None = None) -> tuple[np.ndarray, MultiresDetails]:
         """Reverse subdivision: coarse data and per-level details of finest-level data ``X``.
