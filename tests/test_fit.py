@@ -148,13 +148,11 @@ def test_the_limit_fit_takes_a_step_toward_the_points():
     assert res.history["rms"][1] < 0.2 * res.history["rms"][0]
 
 
-def test_closest_points_fall_back_to_every_face(monkeypatch):
-    import hybridsub._refiner.closest as closest
-
-    monkeypatch.setattr(closest, "_MAX_CANDIDATES", 8)
+def test_closest_points_of_far_points_are_exact():
     V, F = load_mesh("mesh_with_border")
     rng = np.random.default_rng(10)
-    q = V[rng.integers(0, len(V), 50)] + 0.5 * rng.normal(size=(50, 3))    # far: the bound settles few
+    q = V[rng.integers(0, len(V), 50)] + 0.5 * rng.normal(size=(50, 3))    # far: many shells of cells
+    q = np.concatenate([q, V.mean(0) + 20.0 * rng.normal(size=(10, 3))])    # and outside the grid
     fp = closest_points(V, F, q)
     f, b, d2 = np.full(len(q), -1), np.zeros((len(q), 3)), np.full(len(q), np.inf)
     closest_among(q, V, F, np.tile(np.arange(len(F)), (len(q), 1)), f, b, d2)

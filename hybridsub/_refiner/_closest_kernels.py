@@ -1,4 +1,5 @@
-"""Numba kernel of the closest point on a triangle mesh among candidate triangles.
+"""Numba kernels of the closest point on a triangle mesh: among candidate triangles, or
+exactly through a uniform grid of cells.
 
 Private. Contiguous float64 / int64 arrays in, outputs allocated by the caller. The closest
 point on one triangle follows the Voronoi regions of its vertices, edges and face (Ericson,
@@ -7,6 +8,7 @@ point on one triangle follows the Voronoi regions of its vertices, edges and fac
 
 from __future__ import annotations
 
+import numpy as np
 from numba import prange
 
 from .._jit import kernel
@@ -106,3 +108,120 @@ def face_systems(face, bary, metric, residual, H, g):
                 for d in range(3):
                     for e in range(3):
                         H[f, a, d, b, e] += w * metric[i, d, e]
+
+
+@kernel
+def bin_faces(P, faces, lo, h, dims, start):
+    """Cell lists of a uniform grid: every face in each cell its bounding box touches.
+
+    ``lo`` (3,) the grid's corner, ``h`` the cell size, ``dims`` (3,) cells per axis;
+    ``start`` (nx·ny·nz + 1,) zeroed by the caller, filled with each cell's offset. Returns
+    the faces of the cells, concatenated (cell ``c`` holds ``out[start[c]:start[c + 1]]``).
+    """
+    nf = faces.shape[0]
+    box = np.empty((nf, 6), np.int64)
+    for f in range(nf):
+        for a in range(3):
+            x0 = min(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a])
+            x1 = max(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a])
+            box[f, a] = min(max(int((x0 - lo[a]) / h), 0), dims[a] - 1)
+            box[f, 3 + a] = min(max(int((x1 - lo[a]) / h), 0), dims[a] - 1)
+    for f in range(nf):
+        for i in range(box[f, 0], box[f, 3] + 1):
+            for j in range(box[f, 1], box[f, 4] + 1):
+                for k in range(box[f, 2], box[f, 5] + 1):
+                    start[(i * dims[1] + j) * dims[2] + k + 1] += 1
+    for c in range(1, start.shape[0]):
+        start[c] += start[c - 1]
+    fill = start[:-1].copy()
+    out = np.empty(start[-1], np.int64)
+    for f in range(nf):
+        for i in range(box[f, 0], box[f, 3] + 1):
+            for j in range(box[f, 1], box[f, 4] + 1):
+                for k in range(box[f, 2], box[f, 5] + 1):
+                    c = (i * dims[1] + j) * dims[2] + k
+                    out[fill[c]] = f
+                    fill[c] += 1
+    return out
+
+
+@kernel(inline="always")
+def _try_face(px, py, pz, P, faces, f, best, bd, bary):
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    u, v, w = _closest_on_triangle(px, py, pz, P, a, b, c)
+    qx = u * P[a, 0] + v * P[b, 0] + w * P[c, 0]
+    qy = u * P[a, 1] + v * P[b, 1] + w * P[c, 1]
+    qz = u * P[a, 2] + v * P[b, 2] + w * P[c, 2]
+    d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+    if best < 0 or d < bd:
+        bary[0], bary[1], bary[2] = u, v, w
+        return f, d
+    return best, bd
+
+
+@kernel(inline="always")
+def _cell_d2(px, py, pz, lo, h, i, j, k):
+    """Squared distance from p to the box of cell (i, j, k)."""
+    return _gap(px, lo[0] + i * h, h) + _gap(py, lo[1] + j * h, h) + _gap(pz, lo[2] + k * h, h)
+
+
+@kernel(inline="always")
+def _gap(x, c0, h):
+    """Squared distance from x to the interval [c0, c0 + h]."""
+    if x < c0:
+        return (c0 - x) ** 2
+    if x > c0 + h:
+        return (x - c0 - h) ** 2
+    return 0.0
+
+
+@kernel(parallel=True)
+def closest_in_grid(points, P, faces, lo, h, dims, start, cell_faces, face_out, bary_out, d2_out):
+    """The closest point of each point on the mesh, exactly, through the grid of :func:`bin_faces`.
+
+    Cells are visited in shells of growing Chebyshev radius r round the cell of the point
+    clamped into the grid; every face point in shell r is at least (r − 1) h + δ away (δ:
+    the clamped point's distance to its own cell's walls; clamping onto the grid's box never
+    lengthens a distance to a point inside it), so the search stops once that reaches the
+    best distance. ``face_out[i] >= 0`` on entry is tried first (a warm start).
+    """
+    m = points.shape[0]
+    nmax = max(dims[0], max(dims[1], dims[2]))
+    for i in prange(m):
+        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+        bary = bary_out[i]
+        best, bd = -1, np.inf
+        if face_out[i] >= 0:
+            best, bd = _try_face(px, py, pz, P, faces, face_out[i], best, bd, bary)
+        cell = np.empty(3, np.int64)
+        delta = np.inf
+        for a in range(3):
+            c = min(max(points[i, a], lo[a]), lo[a] + dims[a] * h)
+            ci = min(max(int((c - lo[a]) / h), 0), dims[a] - 1)
+            cell[a] = ci
+            delta = min(delta, c - (lo[a] + ci * h), lo[a] + (ci + 1) * h - c)
+        delta = max(delta, 0.0)
+        for r in range(nmax + 1):
+            if r > 0:
+                lb = (r - 1) * h + delta
+                if lb * lb >= bd:
+                    break
+            for di in range(-r, r + 1):
+                ii = cell[0] + di
+                if ii < 0 or ii >= dims[0]:
+                    continue
+                for dj in range(-r, r + 1):
+                    jj = cell[1] + dj
+                    if jj < 0 or jj >= dims[1]:
+                        continue
+                    inner = abs(di) < r and abs(dj) < r
+                    dk = -r
+                    while dk <= r:
+                        kk = cell[2] + dk
+                        if 0 <= kk < dims[2] and _cell_d2(px, py, pz, lo, h, ii, jj, kk) < bd:
+                            c = (ii * dims[1] + jj) * dims[2] + kk
+                            for t in range(start[c], start[c + 1]):
+                                best, bd = _try_face(px, py, pz, P, faces, cell_faces[t], best, bd, bary)
+                        dk += 2 * r if inner and r > 0 else 1
+        face_out[i] = best
+        d2_out[i] = bd

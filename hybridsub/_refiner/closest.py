@@ -1,11 +1,9 @@
 """Closest points on a triangle mesh, for many points at once.
 
-A k-d tree on the triangles' centroids proposes the k nearest triangles of each point; the
-kernel (:mod:`._closest_kernels`) finds the closest point on each. The answer is exact, not a
-heuristic: a triangle whose centroid is farther than d from a point has no point nearer than
-d − r (r: the largest centroid-to-vertex distance), so a point is settled once its k-th
-centroid is at least its best distance + r away; the others are asked again with twice the
-candidates, until every triangle has been tried.
+The faces are binned into a uniform grid of cells (every cell its bounding box touches); a
+kernel (:mod:`._closest_kernels`) visits each point's cells in shells of growing radius and
+stops once no face in the next shell can be closer than the best found. The answer is exact,
+not a heuristic, for points near the surface and far from it alike.
 """
 
 from __future__ import annotations
@@ -14,11 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._closest_kernels import closest_among
+from ._closest_kernels import bin_faces, closest_in_grid
 
-_FIRST_CANDIDATES = 8
-_MAX_SPLIT = 16
-_MAX_CANDIDATES = 256
+#: Grid cell size in mean edge lengths.
+_CELL_EDGES = 1.5
+#: Cells per face at most (a coarse cell size for meshes spread thin over a large box).
+_CELLS_PER_FACE = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,95 +53,41 @@ def closest_points(P: np.ndarray, faces: np.ndarray, queries: np.ndarray) -> Foo
 class ClosestPoints:
     """Closest points of fixed query points on a mesh of fixed faces whose vertices move.
 
-    The k-d tree holds sample points of the triangles: a triangle of reach r (largest
-    centroid-to-corner distance) is split evenly into s² similar pieces, s = ceil(r / ρ)
-    (ρ: the median reach, s at most 16), and contributes their centroids, so every point of
-    a triangle is within ρ' = max r / s of one of its samples. A triangle none of whose
-    samples is among a query's k nearest (the k-th at distance D) is then at least D − ρ'
-    away: a query is settled once D − ρ' reaches its best distance; the others are asked
-    again with twice the candidates (past 256, every face is tried). Each :meth:`search` first tries the candidates of the
-    last query, with D lowered by how far the mesh's vertices moved since (summed), so a
-    fit whose surface moves less and less asks the tree for fewer and fewer points.
+    Each :meth:`search` bins the faces at the current positions into a grid of cells about
+    1.5 mean edge lengths wide and tries each query's previous closest face first, so a fit
+    whose surface moves little visits one or two cells per point.
     """
 
     def __init__(self, faces: np.ndarray, queries: np.ndarray):
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
         self.queries = np.ascontiguousarray(queries, dtype=np.float64)
-        m = len(self.queries)
-        self.k = min(_FIRST_CANDIDATES, len(self.faces))
-        self.candidates = np.full((m, self.k), -1, dtype=np.int64)
-        self.kth = np.full(m, -np.inf)          # k-th sample's distance at the query
-        self.drift = np.zeros(m)                # how far any vertex may have moved since then
-        self.last = None                        # vertex positions at the last search
-        self.split = None                       # pieces per side, per face (set at the first search)
+        self.previous = np.full(len(self.queries), -1, dtype=np.int64)
 
     def search(self, P: np.ndarray) -> Footpoints:
         P = np.ascontiguousarray(P, dtype=np.float64)
-        faces, queries = self.faces, self.queries
-        m = len(queries)
-        tri = P[faces]
-        reach = np.sqrt(((tri - tri.mean(axis=1)[:, None, :]) ** 2).sum(axis=2)).max(axis=1)
-        if self.split is None:
-            rho = max(float(np.median(reach)), 1e-300)
-            self.split = np.minimum(np.ceil(reach / rho), _MAX_SPLIT).astype(np.int64).clip(1)
-        rho = float((reach / self.split).max())
-        if self.last is not None:
-            self.drift += float(np.sqrt(((P - self.last) ** 2).sum(axis=1)).max())
-        self.last = P
-        face = np.full(m, -1, dtype=np.int64)
+        faces, m = self.faces, len(self.queries)
+        lo, h, dims = _grid(P, faces)
+        start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
+        cell_faces = bin_faces(P, faces, lo, h, dims, start)
+        face = self.previous.copy()
         bary = np.zeros((m, 3))
         d2 = np.full(m, np.inf)
-        closest_among(queries, P, faces, self.candidates, face, bary, d2)
-        todo = np.flatnonzero(self.kth - self.drift - rho < np.sqrt(d2))
-        if len(todo):
-            owner, sample = _samples(tri, self.split)
-            from scipy.spatial import cKDTree  # (imported when used: it costs start-up time)
-
-            tree = cKDTree(sample)
-        k = self.k
-        while len(todo):
-            cd, ci = tree.query(queries[todo], k=k, workers=-1)
-            cand = np.ascontiguousarray(owner[ci.reshape(len(todo), k)])
-            f, b, d = face[todo], bary[todo], d2[todo]
-            closest_among(queries[todo], P, faces, cand, f, b, d)
-            face[todo], bary[todo], d2[todo] = f, b, d
-            kth = np.full(len(todo), np.inf) if k >= len(owner) else cd.reshape(len(todo), k)[:, -1]
-            if k == self.k:  # keep the first round's candidates for the next search
-                self.candidates[todo], self.kth[todo], self.drift[todo] = cand, kth, 0.0
-            todo = todo[kth - rho < np.sqrt(d)]
-            k = min(2 * k, len(owner))
-            if k > _MAX_CANDIDATES and len(todo):  # far from a coarse, uneven mesh: try every face
-                _every_face(queries, P, faces, todo, face, bary, d2)
-                break
+        closest_in_grid(self.queries, P, faces, lo, h, dims, start, cell_faces, face, bary, d2)
+        self.previous = face
         Q = np.einsum("mi,mij->mj", bary, P[faces[face]])
         return Footpoints(face, bary, Q, np.sqrt(d2))
 
 
-def _every_face(queries, P, faces, todo, face, bary, d2, chunk_bytes=1 << 24) -> None:
-    """The closest point of each query in ``todo`` among all faces, in chunks of queries."""
-    nf = len(faces)
-    step = max(1, chunk_bytes // (8 * nf))
-    for lo in range(0, len(todo), step):
-        t = todo[lo:lo + step]
-        every = np.tile(np.arange(nf, dtype=np.int64), (len(t), 1))
-        f, b, d = face[t], bary[t], d2[t]
-        closest_among(queries[t], P, faces, every, f, b, d)
-        face[t], bary[t], d2[t] = f, b, d
-
-
-def _samples(tri: np.ndarray, split: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Owner face and position of the samples: the centroids of each face's s² pieces."""
-    owners, points = [], []
-    for s in np.unique(split):
-        fs = np.flatnonzero(split == s)
-        b = _piece_centroids(int(s))                               # (s², 3) barycentric
-        owners.append(np.repeat(fs, len(b)))
-        points.append(np.einsum("pi,fij->fpj", b, tri[fs]).reshape(-1, 3))
-    return np.concatenate(owners), np.concatenate(points)
-
-
-def _piece_centroids(s: int) -> np.ndarray:
-    """Barycentric centroids of the s² triangles of a triangle split evenly s times per side."""
-    up = [(i + 1 / 3, j + 1 / 3, s - 1 - i - j + 1 / 3) for i in range(s) for j in range(s - i)]
-    down = [(i + 2 / 3, j + 2 / 3, s - 2 - i - j + 2 / 3) for i in range(s - 1) for j in range(s - 1 - i)]
-    return np.array(up + down) / s
+def _grid(P: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
+    """Corner, cell size and cells per axis of the grid over the vertices the faces use."""
+    used = P[np.unique(faces)]
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    tri = P[faces]
+    edge = float(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).mean())
+    extent = np.maximum(hi - lo, 0.0)
+    h = max(_CELL_EDGES * edge, float(extent.max()) * 1e-9, 1e-300)
+    while True:
+        dims = np.maximum(np.ceil(extent / h).astype(np.int64), 1)
+        if int(np.prod(dims)) <= max(_CELLS_PER_FACE * len(faces), 64):
+            return lo, h, dims
+        h *= 1.5
