@@ -157,3 +157,25 @@ def test_closest_points_of_far_points_are_exact():
     f, b, d2 = np.full(len(q), -1), np.zeros((len(q), 3)), np.full(len(q), np.inf)
     closest_among(q, V, F, np.tile(np.arange(len(F)), (len(q), 1)), f, b, d2)
     assert np.abs(fp.distance - np.sqrt(d2)).max() < 1e-15
+
+
+def test_an_update_that_raises_the_error_is_halved_back(monkeypatch):
+    import hybridsub._refiner.fitting as fitting
+
+    rng = np.random.default_rng(11)
+    r = hybridsub.refine(FC, CREASES, levels=2)
+    pts = _sample(r, VC, 3000, rng)
+    start = VC + 0.05 * EDGE * rng.normal(size=VC.shape) / np.sqrt(3)
+    true_update, calls = fitting._update, []
+
+    def overshooting(*args):
+        calls.append(1)
+        return true_update(*args) * (16.0 if len(calls) == 1 else 1.0)   # the first update 16 times too long
+
+    monkeypatch.setattr(fitting, "_update", overshooting)
+    res = hybridsub.fit(FC, pts, CREASES, V0=start, levels=2, max_iterations=10)
+    rms = res.history["rms"]
+    assert np.all(np.diff(rms) <= 1e-9 * rms[:-1])       # each accepted update lowered the error
+    assert rms[1] < 0.5 * rms[0]                         # the halved first update still helped
+    diag = np.linalg.norm(pts.max(0) - pts.min(0))
+    assert res.converged and np.abs(res.vertices - VC).max() < 1e-8 * diag
