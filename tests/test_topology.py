@@ -68,7 +68,10 @@ def test_direct_application_equals_matrix_bit_for_bit(data, scheme, levels):
     X = V
     for level, plan, faces, child, offsets in _levels(V, F, tags, scheme, levels):
         Y = apply_step(level, plan, X)
-        assert np.array_equal(Y, step_matrix(level, plan) @ X)
+        S = step_matrix(level, plan)
+        assert np.array_equal(Y, S @ X)
+        for other in (X[:, :2], np.column_stack([X, X[:, 0]])):  # the general path beside the three-column one
+            assert np.array_equal(apply_step(level, plan, other), S @ other)
         X = Y
 
 
