@@ -164,10 +164,10 @@ def _basis(P):
     return np.stack([np.ones_like(s), s, u, s * s, s * u, u * u], -1)
 
 
-def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
-    """Interpolation of the last level: vertex ids (q, 6), weights for the value, ∂/∂u, ∂/∂v,
-    ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (q, 6 each) at every point, from six vertices around it (quadratic
-    in the chart; second derivatives zero where it falls back to linear)."""
+def stencil_nodes(p: Patches):
+    """The per-node part of :func:`stencil`: vertex ids (k, 6), the interpolation matrix
+    (k, 6, 6), whether it is used (k,) (else linear), and the face's frame: centroid (k, 1, 2),
+    size (k, 1, 1), corners (k, 3, 2)."""
     lvl = p.level
     nbr, R, t = glue_maps(p.shape, lvl.twin, p.face)
     tw = lvl.twin[3 * p.face[:, None] + np.arange(3)]
@@ -186,19 +186,34 @@ def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
     A[~full] = np.eye(6)
     full &= np.linalg.cond(A) < MAX_CONDITION  # slivers (√3 crease sectors grow a face per level)
     A[~full] = np.eye(6)
-    x = (np.einsum("qc,qcd->qd", bary, here[qnode]) - c0[qnode, 0]) / scale[qnode, 0]
+    return ids, A, full, c0, scale, here
+
+
+def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
+    """Interpolation of the last level: vertex ids (q, 6), weights for the value, ∂/∂u, ∂/∂v,
+    ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (q, 6 each) at every point, from six vertices around it (quadratic
+    in the chart; second derivatives zero where it falls back to linear)."""
+    ids, A, full, c0, scale, here = stencil_nodes(p)
+    return (ids[qnode], *stencil_weights(A[qnode], full[qnode], c0[qnode, 0], scale[qnode, 0], here[qnode],
+                                          p.uv[qnode], bary))
+
+
+def stencil_weights(A, full, c0, scale, here, uv, bary):
+    """:func:`stencil`'s weights from per-point copies of :func:`stencil_nodes`' data (``c0``
+    (q, 2), ``scale`` (q, 1)) and the points' face corners in (u, v), ``uv`` (q, 3, 2)."""
+    x = (np.einsum("qc,qcd->qd", bary, here) - c0) / scale
     s, u = x[:, 0], x[:, 1]
     z, o = np.zeros_like(s), np.ones_like(s)
     t2 = 2 * o
     rhs = np.stack([_basis(x), np.stack([z, o, z, 2 * s, u, z], -1), np.stack([z, z, o, z, s, 2 * u], -1),
                     np.stack([z, z, z, t2, z, z], -1), np.stack([z, z, z, z, o, z], -1),
                     np.stack([z, z, z, z, z, t2], -1)], -1)
-    W = np.linalg.solve(np.swapaxes(A, 1, 2)[qnode], rhs)  # (q, 6, 6): value, d/ds, d/dt, d²/ds², d²/dsdt, d²/dt²
-    lin = ~full[qnode]
+    W = np.linalg.solve(np.swapaxes(A, 1, 2), rhs)  # (q, 6, 6): value, d/ds, d/dt, d²/ds², d²/dsdt, d²/dt²
+    lin = ~full
     if lin.any():  # a boundary face or a sliver: linear interpolation
         W[lin] = 0.0
         W[lin, :3, 0] = bary[lin]
-        E = here[qnode[lin]] / scale[qnode[lin]]
+        E = here[lin] / scale[lin, :, None]
         Minv = np.linalg.inv(np.stack([E[:, 1] - E[:, 0], E[:, 2] - E[:, 0]], -1))  # rows: d bary1,2 / d(s,t)
         W[lin, 1:3, 1:3] = Minv
         W[lin, 0, 1:3] = -Minv.sum(axis=1)
@@ -206,8 +221,8 @@ def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
     W[at, :, 0] = 0.0
     W[at, np.argmax(bary[at], axis=1), 0] = 1.0
     # d/d(u,v) = d/d(s,t) · d(s,t)/d(u,v), the chart frame being affine in (u, v) over the face.
-    X = here[qnode] / scale[qnode]
-    U = p.uv[qnode]
+    X = here / scale[:, :, None]
+    U = uv
     Mx = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], -1)  # columns: ∂x/∂(bary1, bary2)
     Mu = np.stack([U[:, 1] - U[:, 0], U[:, 2] - U[:, 0]], -1)
     J = Mx @ np.linalg.inv(Mu)  # ∂(s,t)/∂(u,v)
@@ -216,4 +231,27 @@ def stencil(p: Patches, qnode: np.ndarray, bary: np.ndarray):
     # Second derivatives (constant over the stencil; for Newton's method in project): Jᵀ H J.
     H = np.stack([np.stack([W[:, :, 3], W[:, :, 4]], -1), np.stack([W[:, :, 4], W[:, :, 5]], -1)], -1)
     Huv = np.einsum("qai,qkab,qbj->qkij", J, H, J)
-    return ids[qnode], W[:, :, 0], Wu, Wv, Huv[:, :, 0, 0], Huv[:, :, 0, 1], Huv[:, :, 1, 1]
+    return W[:, :, 0], Wu, Wv, Huv[:, :, 0, 0], Huv[:, :, 0, 1], Huv[:, :, 1, 1]
+
+
+def direct_rows(inp: RefineInput, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, tol: float,
+                max_levels: int):
+    """The rows of :func:`.walk.walk_rows` by the direct descent, every patch refined where it
+    is met (no cache): the reference the cached walk is tested against."""
+    faces0, qn = np.unique(f, return_inverse=True)
+    p, sel0 = start(inp, faces0)
+    maps = [sel0]
+    qn, bb = qn.ravel(), b
+    for k in range(depth):
+        p, A, qn, bb = step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
+        maps.append(A)
+    ids, *weights = stencil(p, qn, bb)
+    L = limit_rows(p, np.unique(ids), inp.scheme, inp.loop_weights, tol, max_levels)
+    q = len(f)
+    W = np.concatenate([w.ravel() for w in weights[:n_rows]])
+    R = sp.csr_matrix((W, np.tile(ids.ravel(), n_rows), np.arange(0, 6 * n_rows * q + 1, 6)),
+                      shape=(n_rows * q, p.level.n_vertices)) @ L
+    for A in reversed(maps):  # all rows (value, derivatives) through the levels at once
+        R = R @ A
+    R = sp.csr_matrix(R)
+    return [R[i * q:(i + 1) * q] for i in range(n_rows)]

@@ -8,8 +8,9 @@ import scipy.sparse as sp
 
 from ..._input import as_vertices, open_gate
 from ..._typing import ArrayLike, LoopWeights, Scheme
-from . import descent as D
+from .cache import PatchTable
 from .project import closest_points, seed_setup
+from .walk import StartKeys, walk_rows
 
 #: Points followed down together (bounds the memory of one pass).
 CHUNK = 20000
@@ -69,6 +70,8 @@ class LimitSurface:
             raise ValueError(f"depth must be a non-negative integer, got {depth!r}")
         self.depth = int(depth) + (int(depth) % 2 if scheme == "sqrt3" else 0)  # Kobbelt: even levels
         self._tol, self._max_levels = 1e-12, 60
+        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels)
+        self._starts = StartKeys(self._inp, self._table)
 
     @property
     def vertices(self) -> np.ndarray:
@@ -108,26 +111,7 @@ class LimitSurface:
         return f, b / b.sum(axis=1, keepdims=True)
 
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
-        inp = self._inp
-        faces0, qn = np.unique(f, return_inverse=True)
-        p, sel0 = D.start(inp, faces0)
-        maps = [sel0]
-        qn, bb = qn.ravel(), b
-        for k in range(depth):
-            p, A, qn, bb = D.step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
-            maps.append(A)
-        ids, *weights = D.stencil(p, qn, bb)
-        needed = np.unique(ids)
-        L = D.limit_rows(p, needed, inp.scheme, inp.loop_weights, self._tol, self._max_levels)
-        q = len(f)
-        n = p.level.n_vertices
-        k = [1, 3, 6][int(derivatives)]
-        W = np.concatenate([w.ravel() for w in weights[:k]])
-        R = sp.csr_matrix((W, np.tile(ids.ravel(), k), np.arange(0, 6 * k * q + 1, 6)), shape=(k * q, n)) @ L
-        for A in reversed(maps):  # all rows (value, derivatives) through the levels at once
-            R = R @ A
-        R = sp.csr_matrix(R)
-        return [R[i * q:(i + 1) * q] for i in range(k)]
+        return walk_rows(self._table, self._starts, f, b, [1, 3, 6][int(derivatives)], depth)
 
     def evaluation_matrix(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False):
         """The sparse rows that give the limit surface at the points: ``evaluate == M @ V``.

@@ -1,0 +1,173 @@
+"""Numba kernels of the patch cache (:mod:`.cache`, :mod:`.walk`).
+
+Private. Contiguous arrays in, outputs allocated by the caller.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..._jit import kernel
+
+
+@kernel
+def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart):
+    """Faces and vertices of every piece in a canonical order.
+
+    Pieces are contiguous: node ``i`` owns faces ``fstart[i]:fstart[i + 1]`` (and the vertices
+    they use). Breadth first from the node's ``centre`` face, entered at its corner 0; every
+    other face is entered at the halfedge it was reached through, and its neighbours are
+    queued in corner order from there. Vertices are numbered as first met. Faces not reached
+    through edges follow in their stored order. Fills ``fperm`` (faces in canonical order),
+    ``vperm`` (vertices in canonical order) and ``vstart`` (k + 1) their ranges per node.
+    """
+    m = len(F)
+    fmark = np.zeros(m, np.bool_)
+    entry = np.zeros(m, np.int64)
+    vseen = np.zeros(n, np.bool_)
+    nv = 0
+    for i in range(len(centre)):
+        a, b = fstart[i], fstart[i + 1]
+        vstart[i] = nv
+        nf = a
+        fperm[nf] = centre[i]
+        fmark[centre[i]] = True
+        entry[centre[i]] = 0
+        nf += 1
+        head = a
+        nxt = a  # next stored face to try when the queue runs dry
+        while head < b:
+            if head == nf:  # not reached through edges: the next unreached face in stored order
+                while fmark[nxt]:
+                    nxt += 1
+                fperm[nf] = nxt
+                fmark[nxt] = True
+                entry[nxt] = 0
+                nf += 1
+            f = fperm[head]
+            head += 1
+            s = entry[f]
+            for j in range(3):
+                v = F[f, (s + j) % 3]
+                if not vseen[v]:
+                    vseen[v] = True
+                    vperm[nv] = v
+                    nv += 1
+            for j in range(3):
+                t = twin[3 * f + (s + j) % 3]
+                if t >= 0 and not fmark[t // 3]:
+                    g = t // 3
+                    fmark[g] = True
+                    entry[g] = t % 3
+                    fperm[nf] = g
+                    nf += 1
+    vstart[len(centre)] = nv
+
+
+@kernel
+def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, fstart, node_of, scale, grid, out, norm):
+    """Per canonical face: its canonical corners, twins, tags and normalised shape.
+
+    ``out`` (m, 13) int64: corner labels (3), canonical twin halfedges (3, −1 none), sharp
+    face (1), ``hbits`` of the halfedges (3: their sharpness's bits), and the shape normalised by a rigid
+    motion of its own (corner 0 at the origin, corner 1 on +x) and the piece's ``scale``,
+    rounded to ``grid`` (3: corner 1's x, corner 2's x and y). ``norm`` (m, 3, 2) gets that
+    normalised shape unrounded.
+    """
+    for r in range(len(fperm)):
+        f = fperm[r]
+        i = node_of[r]
+        base = fstart[i]
+        for c in range(3):
+            out[r, c] = vrank[F[f, c]]
+            t = twin[3 * f + c]
+            out[r, 3 + c] = 3 * (frank[t // 3] - base) + t % 3 if t >= 0 else -1
+            out[r, 7 + c] = hbits[3 * f + c]
+        out[r, 6] = 1 if face_sharp[f] else 0
+        ax, ay = shape[f, 0, 0], shape[f, 0, 1]
+        ex, ey = shape[f, 1, 0] - ax, shape[f, 1, 1] - ay
+        ln = math.sqrt(ex * ex + ey * ey)
+        co, si = ex / ln, ey / ln
+        dx, dy = shape[f, 2, 0] - ax, shape[f, 2, 1] - ay
+        s = scale[i]
+        norm[r, 0, 0] = 0.0
+        norm[r, 0, 1] = 0.0
+        norm[r, 1, 0] = ln / s
+        norm[r, 1, 1] = 0.0
+        norm[r, 2, 0] = (co * dx + si * dy) / s
+        norm[r, 2, 1] = (co * dy - si * dx) / s
+        out[r, 10] = round(norm[r, 1, 0] / grid)
+        out[r, 11] = round(norm[r, 2, 0] / grid)
+        out[r, 12] = round(norm[r, 2, 1] / grid)
+
+
+@kernel
+def pick_children(key, bary, uv, cand_start, cand_count, M, G, chosen, bary_out, uv_out):
+    """One level of the walk: every point's child face among its key's candidates (the
+    largest smallest barycentric coordinate, the first of equals), its coordinates there and
+    the child's corners in (u, v). ``chosen`` gets the candidate, −1 where the key has no
+    candidates yet."""
+    b = np.empty(3)
+    for q in range(len(key)):
+        s = cand_start[key[q]]
+        chosen[q] = -1
+        if s < 0:
+            continue
+        best = -np.inf
+        for j in range(s, s + cand_count[key[q]]):
+            lo = np.inf
+            for i in range(3):
+                b[i] = M[j, i, 0] * bary[q, 0] + M[j, i, 1] * bary[q, 1] + M[j, i, 2] * bary[q, 2]
+                lo = min(lo, b[i])
+            if lo > best:
+                best = lo
+                chosen[q] = j
+                bary_out[q, :] = b
+        j = chosen[q]
+        for i in range(3):
+            for d in range(2):
+                uv_out[q, i, d] = G[j, i, 0] * uv[q, 0, d] + G[j, i, 1] * uv[q, 1, d] + G[j, i, 2] * uv[q, 2, d]
+
+
+@kernel
+def back_rows(W, final, path, keys, nv, st_ids, st_L, st_L0, t_start, t_end, t_row, t_col, t_val, out):
+    """Every point's rows over its first patch's vertices: the stencil weights ``W`` (q, r, 6)
+    times the stencil vertices' limit rows, then back through the recorded steps.
+
+    ``final`` (q,) stencil record of the last key, ``path`` (q, d) the candidates chosen,
+    ``keys`` (q, d + 1) the keys met; ``out`` (q, r, nv_max) zeroed by the caller.
+    """
+    nmax = 0
+    for q in range(len(final)):
+        for lev in range(keys.shape[1]):
+            nmax = max(nmax, nv[keys[q, lev]])
+    nr = W.shape[1]
+    d = path.shape[1]
+    cur = np.empty((nr, nmax))
+    nxt = np.empty((nr, nmax))
+    for q in range(len(final)):
+        rec = final[q]
+        n = nv[keys[q, d]]
+        cur[:, :n] = 0.0
+        for j in range(6):
+            if st_ids[rec, j] < 0:
+                continue
+            base = st_L0[rec] + j * n
+            for r in range(nr):
+                w = W[q, r, j]
+                if w != 0.0:
+                    for v in range(n):
+                        cur[r, v] += w * st_L[base + v]
+        for lev in range(d - 1, -1, -1):
+            c = path[q, lev]
+            m = nv[keys[q, lev]]
+            nxt[:, :m] = 0.0
+            for e in range(t_start[c], t_end[c]):
+                a, b, x = t_row[e], t_col[e], t_val[e]
+                for r in range(nr):
+                    nxt[r, b] += cur[r, a] * x
+            cur, nxt = nxt, cur
+        m = nv[keys[q, 0]]
+        out[q, :, :m] = cur[:, :m]

@@ -1,0 +1,291 @@
+"""The patch cache: every distinct patch's step computed once.
+
+Below the first levels the patches of the descent (:mod:`.descent`) repeat: regular √3 and
+Loop neighbourhoods, crease and boundary sectors, the neighbourhood of an extraordinary
+vertex, each level's shapes the same up to a rigid motion and a scale. A patch is described
+by a *key*: its faces and vertices in a canonical order (breadth first from the centre face,
+entered at its corner 0), their connectivity, tags and shapes (each face's corners moved by a
+rigid motion of its own, the whole patch scaled by the centre face's first edge, rounded to
+:data:`GRID`), and Kobbelt's step parity for ``"sqrt3"``. Two patches with one key are the
+same tagged mesh up to the numbering of their vertices, so one of them, the key's
+*representative*, stands for all: it is refined once with the project's own step
+(``descent.step``'s machinery) and what the walk needs is kept in flat tables:
+
+- per key, its candidate child faces (those ``descent.step`` chooses among), each with the
+  map ``M`` of the point's barycentric coordinates into the child's, the map ``G`` of the
+  child's corners over the centre face (to follow (u, v)) and, once a point has chosen it,
+  the child's key and the step's rows restricted to (child patch × patch) vertices ``T``;
+- per key ending a descent, the interpolation stencil's six vertices with their exact limit
+  rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
+
+Everything is exact by construction: the tables hold the existing code's results on the
+representatives.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._topology import Level, child_level, face_parents, plan_step
+from ..chart import barycentric, child_shapes, plan_supports
+from ..stencils import step_matrix
+from ._cache_kernels import canonical_order, face_records
+from .descent import Patches, _candidates, cut_patches, limit_rows, ring_faces, stencil_nodes
+
+#: Shapes in a key are rounded to this (relative to the centre face's first edge).
+GRID = 1e-9
+
+
+class Grow:
+    """A flat array grown by appending blocks (amortised doubling)."""
+
+    def __init__(self, shape=(), dtype=np.float64, fill=0):
+        self._a = np.full((16,) + tuple(shape), fill, dtype)
+        self.fill = fill
+        self.n = 0
+
+    def append(self, block) -> int:
+        block = np.asarray(block, self._a.dtype)
+        start, end = self.n, self.n + len(block)
+        if end > len(self._a):
+            new = np.full((max(2 * len(self._a), end),) + self._a.shape[1:], self.fill, self._a.dtype)
+            new[:self.n] = self._a[:self.n]
+            self._a = new
+        self._a[start:end] = block
+        self.n = end
+        return start
+
+    def extend_to(self, n: int):
+        if n > self.n:
+            self.append(np.full((n - self.n,) + self._a.shape[1:], self.fill, self._a.dtype))
+
+    @property
+    def a(self) -> np.ndarray:
+        return self._a[:self.n]
+
+
+def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np.ndarray, fstart: np.ndarray):
+    """Canonical orders and key records of the pieces of ``level`` (node ``i``: faces
+    ``fstart[i]:fstart[i + 1]``, centre face ``centre[i]``).
+
+    Returns ``fperm``, ``vperm``, ``vstart`` (canonical faces and vertices, the vertex ranges
+    per node), ``rec`` (m, 13) int64 per canonical face and ``norm`` (m, 3, 2) the normalised
+    shapes (see :func:`._cache_kernels.face_records`).
+    """
+    F = np.ascontiguousarray(level.faces, dtype=np.int64)
+    m, k = len(F), len(centre)
+    fperm, vperm = np.empty(m, np.int64), np.empty(level.n_vertices, np.int64)
+    vstart = np.empty(k + 1, np.int64)
+    twin = np.ascontiguousarray(level.twin, dtype=np.int64)
+    canonical_order(F, twin, level.n_vertices, fstart, centre, fperm, vperm, vstart)
+    frank = np.empty(m, np.int64)
+    frank[fperm] = np.arange(m)
+    node_f = np.repeat(np.arange(k), np.diff(fstart))
+    vrank = np.empty(level.n_vertices, np.int64)
+    vrank[vperm] = np.arange(len(vperm)) - np.repeat(vstart[:-1], np.diff(vstart))
+    hs = np.zeros(3 * m) if level.hsharp is None else np.ascontiguousarray(level.hsharp, dtype=np.float64)
+    sc = shape[centre]
+    scale = np.hypot(sc[:, 1, 0] - sc[:, 0, 0], sc[:, 1, 1] - sc[:, 0, 1])
+    rec = np.empty((m, 13), np.int64)
+    norm = np.empty((m, 3, 2))
+    face_records(F, twin, hs.view(np.int64), level.face_sharp, np.ascontiguousarray(shape, dtype=np.float64), fperm,
+                 frank, vrank, fstart, node_f, scale, GRID, rec, norm)
+    return fperm, vperm, vstart, rec, norm
+
+
+class PatchTable:
+    """Keys, representatives and the transition tables of one scheme (see the module doc)."""
+
+    def __init__(self, scheme: str, loop_weights: str, tol: float = 1e-12, max_levels: int = 60):
+        self.scheme, self.loop_weights = scheme, loop_weights
+        self.tol, self.max_levels = tol, max_levels
+        self.index: dict[bytes, int] = {}
+        self.reps: list[tuple] = []  # per key: F, twin, hsharp, face_sharp, corner, shape (canonical)
+        self.parity: list[int] = []  # per key: 1 when the next step is odd ("sqrt3" only)
+        self.nv = Grow((), np.int64)
+        self.cand_start = Grow((), np.int64, -1)  # per key (−1: not refined yet)
+        self.cand_count = Grow((), np.int64)
+        self.M = Grow((3, 3))  # per candidate
+        self.G = Grow((3, 3))
+        self.child = Grow((), np.int64, -1)  # the child's key (−1: not cut yet)
+        self.owner = Grow((), np.int64)  # the key a candidate belongs to
+        self.slot = Grow((), np.int64)  # its index among the key's 24 candidate slots
+        self.t_start = Grow((), np.int64)  # T of each candidate: entries t_start:t_end
+        self.t_end = Grow((), np.int64)
+        self.t_row = Grow((), np.int64)
+        self.t_col = Grow((), np.int64)
+        self.t_val = Grow(())
+        self.final = Grow((), np.int64, -1)  # per key: its stencil record (−1: none yet)
+        self.st_ids = Grow((6,), np.int64)  # per stencil record
+        self.st_L = Grow((), np.float64)  # limit rows of the six vertices, 6 × nv, from st_L0
+        self.st_L0 = Grow((), np.int64)
+        self.st_node = Grow((9,))  # c0 (2), scale (1), the face's corners (6)
+        self.st_full = Grow((), np.bool_)
+        self.st_A = Grow((6, 6))
+        self._recent = None
+
+    @property
+    def n_keys(self) -> int:
+        return len(self.reps)
+
+    def register(self, level, corner, shape, centre, fstart, parity):
+        """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
+        the canonical vertex orders: ``vperm``, ``vstart``."""
+        fperm, vperm, vstart, rec, norm = canonicalise(level, corner, shape, centre, fstart)
+        hs = np.zeros(3 * level.n_faces) if level.hsharp is None else level.hsharp
+        cv = corner[vperm]
+        ids = np.empty(len(centre), np.int64)
+        pre = bytes([parity])
+        for i in range(len(centre)):
+            a, b = fstart[i], fstart[i + 1]
+            va, vb = vstart[i], vstart[i + 1]
+            key = pre + rec[a:b].tobytes() + np.packbits(cv[va:vb]).tobytes() + int(vb - va).to_bytes(4, "little")
+            kid = self.index.get(key)
+            if kid is None:
+                kid = self.index[key] = len(self.reps)
+                f = fperm[a:b]
+                self.reps.append((rec[a:b, :3].copy(), rec[a:b, 3:6].ravel().copy(), hs.reshape(-1, 3)[f].ravel(),
+                                  level.face_sharp[f].copy(), cv[va:vb].copy(), norm[a:b].copy()))
+                self.parity.append(parity)
+            ids[i] = kid
+        n = self.n_keys
+        for g in (self.cand_start, self.final):
+            g.extend_to(n)
+        self.cand_count.extend_to(n)
+        if self.nv.n < n:
+            self.nv.append([len(self.reps[j][4]) for j in range(self.nv.n, n)])
+        return ids, vperm, vstart
+
+    def patches(self, keys: np.ndarray):
+        """The representatives of ``keys`` as one mesh of disjoint pieces; also the face and
+        vertex offsets of each piece (its centre is its first face)."""
+        reps = [self.reps[k] for k in keys]
+        nf = np.array([len(r[0]) for r in reps], np.int64)
+        nv = np.array([len(r[4]) for r in reps], np.int64)
+        foff = np.concatenate([[0], np.cumsum(nf)])
+        voff = np.concatenate([[0], np.cumsum(nv)])
+        F = np.concatenate([r[0] for r in reps]) + np.repeat(voff[:-1], nf)[:, None]
+        tw = np.concatenate([r[1] for r in reps])
+        tw = np.where(tw >= 0, tw + 3 * np.repeat(foff[:-1], 3 * nf), -1)
+        hs = np.concatenate([r[2] for r in reps])
+        level = Level(F, int(voff[-1]), tw, hs if hs.any() else None, np.concatenate([r[3] for r in reps]))
+        uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(keys), axis=0)
+        p = Patches(level, np.concatenate([r[4] for r in reps]), np.concatenate([r[5] for r in reps]),
+                    foff[:-1].copy(), uv)
+        return p, foff, voff
+
+    def _refine(self, keys: np.ndarray):
+        """One step of the representatives of ``keys`` (all of one parity)."""
+        p, foff, voff = self.patches(keys)
+        lvl = p.level
+        plan = plan_step(lvl, p.corner, self.scheme, 2 - self.parity[keys[0]], self.loop_weights)
+        S = step_matrix(lvl, plan)
+        faces1, child, offsets = child_level(lvl, plan)
+        ids, w = plan_supports(lvl.faces, plan, lvl.n_vertices)
+        parent = face_parents(offsets)
+
+        def shapes_of(faces):
+            return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
+
+        cid, ccorn = _candidates(p, offsets, shapes_of)
+        return dict(keys=keys, p=p, voff=voff, plan=plan, S=S.tocsr(), faces1=faces1, child=child, shapes_of=shapes_of,
+                    cid=cid, ccorn=ccorn)
+
+    def _refined(self, keys: np.ndarray):
+        """:meth:`_refine` per parity; the last result is kept for :meth:`fill_children`."""
+        out = []
+        par = np.array([self.parity[k] for k in keys])
+        for b in np.unique(par):
+            out.append(self._refine(keys[par == b]))
+        self._recent = out
+        return out
+
+    def fill_steps(self, keys: np.ndarray):
+        """The candidates of ``keys`` (unique, not refined yet): their maps ``M`` and ``G``."""
+        for r in self._refined(keys):
+            X = r["p"].shape[r["p"].face]  # (k, 3, 2)
+            cid, cc = r["cid"], r["ccorn"]
+            M = np.swapaxes(barycentric(cc[:, :, None], X[:, None, :, :]), 2, 3)  # (k, 24, 3 bary, 3 corners)
+            G = barycentric(X[:, None, None], cc)  # (k, 24, 3 child corners, 3)
+            valid = cid >= 0
+            cnt = valid.sum(axis=1)
+            kk, jj = np.nonzero(valid)
+            start = self.M.append(M[kk, jj])
+            self.G.append(G[kk, jj])
+            self.child.append(np.full(len(kk), -1))
+            self.owner.append(r["keys"][kk])
+            self.slot.append(jj)
+            self.t_start.append(np.zeros(len(kk), np.int64))
+            self.t_end.append(np.zeros(len(kk), np.int64))
+            self.cand_start.a[r["keys"]] = start + np.concatenate([[0], np.cumsum(cnt)[:-1]])
+            self.cand_count.a[r["keys"]] = cnt
+
+    def fill_children(self, cands: np.ndarray):
+        """Cut the child patches of the candidates ``cands`` (unique): their keys and ``T``."""
+        owners = self.owner.a[cands]
+        recent = self._recent or []
+        have = np.concatenate([r["keys"] for r in recent]) if recent else np.zeros(0, np.int64)
+        if not np.isin(owners, have).all():
+            recent = self._refined(np.unique(owners))
+        for r in recent:
+            pick = np.isin(owners, r["keys"])
+            if pick.any():
+                self._cut_children(r, cands[pick], owners[pick])
+
+    def _cut_children(self, r, cands, owners):
+        node = np.searchsorted(r["keys"], owners) if _sorted(r["keys"]) else _position(r["keys"], owners)
+        faces1, p = r["faces1"], r["p"]
+        centre = r["cid"][node, self.slot.a[cands]]
+        n_new = r["plan"].n_new
+        corner1 = np.concatenate([p.corner, np.zeros(n_new - p.level.n_vertices, bool)])
+        nd, f = ring_faces(faces1, n_new, centre)
+        nxt, corner_n, vsel, fkeys = cut_patches(r["child"], corner1, nd, f)
+        cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
+        used, back = np.unique(f, return_inverse=True)
+        shape_n = r["shapes_of"](used)[back]
+        fstart = np.searchsorted(nd, np.arange(len(centre) + 1))
+        parity = self.parity[owners[0]] ^ 1 if self.scheme == "sqrt3" else 0
+        kids, vperm, vstart = self.register(nxt, corner_n, shape_n, cur, fstart, parity)
+        T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order
+        # Columns: the parent piece's vertices (canonical: the representative's own order).
+        row_node = np.searchsorted(vstart, T.row, side="right") - 1
+        col = T.col - r["voff"][node[row_node]]
+        row = T.row - vstart[row_node]
+        bounds = np.searchsorted(row_node, np.arange(len(centre) + 1))
+        base = self.t_row.append(row)
+        self.t_col.append(col)
+        self.t_val.append(T.data)
+        self.t_start.a[cands] = base + bounds[:-1]
+        self.t_end.a[cands] = base + bounds[1:]
+        self.child.a[cands] = kids
+
+    def fill_stencils(self, keys: np.ndarray):
+        """The last interpolation's data of ``keys`` (unique, none yet): stencil vertices, their
+        limit rows over the patch, the stencil matrix."""
+        p, foff, voff = self.patches(keys)
+        ids, A, full, c0, scale, here = stencil_nodes(p)
+        needed = np.unique(ids[ids >= 0])
+        L = limit_rows(p, needed, self.scheme, self.loop_weights, self.tol, self.max_levels)
+        rec = self.st_ids.append(np.where(ids >= 0, ids - voff[:-1, None], -1))
+        self.st_A.append(A)
+        self.st_full.append(full)
+        self.st_node.append(np.concatenate([c0.reshape(-1, 2), scale.reshape(-1, 1), here.reshape(-1, 6)], axis=1))
+        nv = np.diff(voff)
+        starts = self.st_L.n + np.concatenate([[0], np.cumsum(6 * nv)[:-1]])
+        flat = np.zeros(int(6 * nv.sum()))
+        Lr = L[np.maximum(ids, 0).ravel()].tocoo()  # row 6 i + j: key i's slot j
+        ok = (ids.ravel() >= 0)[Lr.row]
+        key = Lr.row[ok] // 6
+        np.add.at(flat, starts[key] - self.st_L.n + (Lr.row[ok] % 6) * nv[key] + Lr.col[ok] - voff[key], Lr.data[ok])
+        self.st_L.append(flat)
+        self.st_L0.append(starts)
+        self.final.a[keys] = rec + np.arange(len(keys))
+
+
+def _sorted(a: np.ndarray) -> bool:
+    return bool(np.all(a[1:] >= a[:-1]))
+
+
+def _position(keys: np.ndarray, x: np.ndarray) -> np.ndarray:
+    order = np.argsort(keys)
+    return order[np.searchsorted(keys[order], x)]

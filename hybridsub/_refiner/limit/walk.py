@@ -1,0 +1,100 @@
+"""The descent as a walk through the patch cache (:mod:`.cache`).
+
+Every point starts at the key of its input face's patch and, level by level, picks its child
+face among the key's candidates (as ``descent.step`` does), moving to the child's key; the
+candidates chosen are recorded. Keys met for the first time are refined (in one batch per
+level), so after the first calls a level is one small kernel over the points. At the end the
+last interpolation's weights times the limit rows of its six vertices give a row over the
+last patch, carried back through the recorded steps' rows to the first patch and onto the
+control vertices: the same products as ``LimitSurface``'s direct descent, in another order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..._input import RefineInput
+from ._cache_kernels import back_rows, pick_children
+from .cache import Grow, PatchTable
+from .descent import ring_faces, start, stencil_weights
+
+
+class StartKeys:
+    """The key of every input face's patch and the control vertex of each of its canonical
+    vertices, found when a face is first evaluated."""
+
+    def __init__(self, inp: RefineInput, table: PatchTable):
+        self.inp, self.table = inp, table
+        self.key = np.full(inp.n_faces, -1, np.int64)
+        self.v0 = np.zeros(inp.n_faces, np.int64)
+        self.vids = Grow((), np.int64)
+
+    def of(self, faces: np.ndarray) -> np.ndarray:
+        new = np.unique(faces[self.key[faces] < 0])
+        if len(new):
+            inp = self.inp
+            p, sel = start(inp, new)
+            node, _ = ring_faces(inp.level.faces, inp.n_vertices, new)
+            fstart = np.searchsorted(node, np.arange(len(new) + 1))
+            ids, vperm, vstart = self.table.register(p.level, p.corner, p.shape, p.face, fstart,
+                                                     int(inp.scheme == "sqrt3"))
+            self.key[new] = ids
+            self.v0[new] = self.vids.append(sel.indices[vperm]) + vstart[:-1]
+        return self.key[faces]
+
+
+def _pick(table: PatchTable, key, bary, uv):
+    """One level for every point: the candidate chosen, the point's barycentric coordinates
+    in it and its corners in (u, v); keys met for the first time are refined first."""
+    uk = np.unique(key)
+    lack = uk[table.cand_start.a[uk] < 0]
+    if len(lack):
+        table.fill_steps(lack)
+    chosen = np.empty(len(key), np.int64)
+    nb, nuv = np.empty_like(bary), np.empty_like(uv)
+    pick_children(key, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a, table.G.a, chosen, nb, nuv)
+    miss = table.child.a[chosen] < 0
+    if miss.any():
+        table.fill_children(np.unique(chosen[miss]))
+    return chosen, nb, nuv
+
+
+def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
+    """Rows over the control vertices of the points (face ``f``, bary ``b``): value, then
+    ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR matrix)."""
+    q = len(f)
+    keys = np.empty((q, depth + 1), np.int64)
+    path = np.empty((q, depth), np.int64)
+    keys[:, 0] = starts.of(f)
+    bary = b.copy()
+    uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
+    for lev in range(depth):
+        path[:, lev], bary, uv = _pick(table, keys[:, lev], bary, uv)
+        keys[:, lev + 1] = table.child.a[path[:, lev]]
+    last = keys[:, depth]
+    uk = np.unique(last)
+    lack = uk[table.final.a[uk] < 0]
+    if len(lack):
+        table.fill_stencils(lack)
+    rec = table.final.a[last]
+    node = table.st_node.a[rec]
+    W = stencil_weights(table.st_A.a[rec], table.st_full.a[rec], node[:, :2], node[:, 2:3],
+                        node[:, 3:].reshape(-1, 3, 2), uv, bary)
+    W = np.ascontiguousarray(np.stack(W[:n_rows], axis=1))
+    nv = table.nv.a
+    nv0 = nv[keys[:, 0]]
+    out = np.zeros((q, n_rows, int(nv0.max()) if q else 0))
+    back_rows(W, rec, path, keys, nv, table.st_ids.a, table.st_L.a, table.st_L0.a, table.t_start.a,
+              table.t_end.a, table.t_row.a, table.t_col.a, table.t_val.a, out)
+    # Onto the control vertices: each point's first patch in canonical order.
+    live = np.arange(out.shape[2])[None, :] < nv0[:, None]
+    cols = starts.vids.a[(starts.v0[f][:, None] + np.arange(out.shape[2])[None, :])[live]]
+    indptr = np.concatenate([[0], np.cumsum(nv0)])
+    n = starts.inp.n_vertices
+    mats = []
+    for r in range(n_rows):
+        M = sp.csr_matrix((out[:, r][live], cols, indptr), shape=(q, n))
+        M.sort_indices()
+        mats.append(M)
+    return mats
