@@ -104,12 +104,14 @@ def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, fstart,
 
 
 @kernel
-def pick_children(key, bary, uv, cand_start, cand_count, M, G, chosen, bary_out, uv_out):
+def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv_out):
     """One level of the walk: every point's child face among its key's candidates (the
     largest smallest barycentric coordinate, the first of equals), its coordinates there and
-    the child's corners in (u, v). ``chosen`` gets the candidate, −1 where the key has no
-    candidates yet."""
+    the child's corners in (u, v). ``M`` (c, 3, 3) takes a point's barycentric coordinates
+    into each candidate's; its inverse transposed holds the candidate's corners over the
+    face. ``chosen`` gets the candidate, −1 where the key has no candidates yet."""
     b = np.empty(3)
+    G = np.empty((3, 3))
     for q in range(len(key)):
         s = cand_start[key[q]]
         chosen[q] = -1
@@ -126,9 +128,18 @@ def pick_children(key, bary, uv, cand_start, cand_count, M, G, chosen, bary_out,
                 chosen[q] = j
                 bary_out[q, :] = b
         j = chosen[q]
+        # G = (Mᵀ)⁻¹: the cofactors of M over its determinant.
+        det = (M[j, 0, 0] * (M[j, 1, 1] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 1])
+               - M[j, 0, 1] * (M[j, 1, 0] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 0])
+               + M[j, 0, 2] * (M[j, 1, 0] * M[j, 2, 1] - M[j, 1, 1] * M[j, 2, 0]))
+        for a in range(3):
+            a1, a2 = (a + 1) % 3, (a + 2) % 3
+            for c in range(3):
+                c1, c2 = (c + 1) % 3, (c + 2) % 3
+                G[a, c] = (M[j, a1, c1] * M[j, a2, c2] - M[j, a1, c2] * M[j, a2, c1]) / det
         for i in range(3):
             for d in range(2):
-                uv_out[q, i, d] = G[j, i, 0] * uv[q, 0, d] + G[j, i, 1] * uv[q, 1, d] + G[j, i, 2] * uv[q, 2, d]
+                uv_out[q, i, d] = G[i, 0] * uv[q, 0, d] + G[i, 1] * uv[q, 1, d] + G[i, 2] * uv[q, 2, d]
 
 
 @kernel

@@ -12,8 +12,8 @@ same tagged mesh up to the numbering of their vertices, so one of them, the key'
 (``descent.step``'s machinery) and what the walk needs is kept in flat tables:
 
 - per key, its candidate child faces (those ``descent.step`` chooses among), each with the
-  map ``M`` of the point's barycentric coordinates into the child's, the map ``G`` of the
-  child's corners over the centre face (to follow (u, v)) and, once a point has chosen it,
+  map ``M`` of the point's barycentric coordinates into the child's (its inverse transposed
+  holds the child's corners over the centre face, to follow (u, v)) and, once a point has chosen it,
   the child's key and the step's rows restricted to (child patch × patch) vertices ``T``;
 - per key ending a descent, the interpolation stencil's six vertices with their exact limit
   rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
@@ -23,6 +23,8 @@ representatives.
 """
 
 from __future__ import annotations
+
+import hashlib
 
 import numpy as np
 
@@ -37,7 +39,7 @@ GRID = 1e-9
 
 
 class Grow:
-    """A flat array grown by appending blocks (amortised doubling)."""
+    """A flat array grown by appending blocks (capacity grown by half)."""
 
     def __init__(self, shape=(), dtype=np.float64, fill=0):
         self._a = np.full((16,) + tuple(shape), fill, dtype)
@@ -48,7 +50,7 @@ class Grow:
         block = np.asarray(block, self._a.dtype)
         start, end = self.n, self.n + len(block)
         if end > len(self._a):
-            new = np.full((max(2 * len(self._a), end),) + self._a.shape[1:], self.fill, self._a.dtype)
+            new = np.full((max(len(self._a) * 3 // 2, end),) + self._a.shape[1:], self.fill, self._a.dtype)
             new[:self.n] = self._a[:self.n]
             self._a = new
         self._a[start:end] = block
@@ -106,14 +108,13 @@ class PatchTable:
         self.cand_start = Grow((), np.int64, -1)  # per key (−1: not refined yet)
         self.cand_count = Grow((), np.int64)
         self.M = Grow((3, 3))  # per candidate
-        self.G = Grow((3, 3))
         self.child = Grow((), np.int64, -1)  # the child's key (−1: not cut yet)
         self.owner = Grow((), np.int64)  # the key a candidate belongs to
         self.slot = Grow((), np.int64)  # its index among the key's 24 candidate slots
         self.t_start = Grow((), np.int64)  # T of each candidate: entries t_start:t_end
         self.t_end = Grow((), np.int64)
-        self.t_row = Grow((), np.int64)
-        self.t_col = Grow((), np.int64)
+        self.t_row = Grow((), np.int32)
+        self.t_col = Grow((), np.int32)
         self.t_val = Grow(())
         self.final = Grow((), np.int64, -1)  # per key: its stencil record (−1: none yet)
         self.st_ids = Grow((6,), np.int64)  # per stencil record
@@ -123,6 +124,13 @@ class PatchTable:
         self.st_full = Grow((), np.bool_)
         self.st_A = Grow((6, 6))
         self._recent = None
+        self._rep_bytes = 0
+
+    @property
+    def nbytes(self) -> int:
+        """What the cache holds, roughly (the representatives estimated)."""
+        grown = sum(g.a.nbytes for g in vars(self).values() if isinstance(g, Grow))
+        return grown + self._rep_bytes + 120 * len(self.index)
 
     @property
     def n_keys(self) -> int:
@@ -139,13 +147,20 @@ class PatchTable:
         for i in range(len(centre)):
             a, b = fstart[i], fstart[i + 1]
             va, vb = vstart[i], vstart[i + 1]
-            key = pre + rec[a:b].tobytes() + np.packbits(cv[va:vb]).tobytes() + int(vb - va).to_bytes(4, "little")
+            h = hashlib.blake2b(pre, digest_size=16)  # 128 bits: a collision is not a practical concern
+            h.update(rec[a:b].tobytes())
+            h.update(np.packbits(cv[va:vb]).tobytes())
+            h.update(int(vb - va).to_bytes(4, "little"))
+            key = h.digest()
             kid = self.index.get(key)
             if kid is None:
                 kid = self.index[key] = len(self.reps)
                 f = fperm[a:b]
-                self.reps.append((rec[a:b, :3].copy(), rec[a:b, 3:6].ravel().copy(), hs.reshape(-1, 3)[f].ravel(),
-                                  level.face_sharp[f].copy(), cv[va:vb].copy(), norm[a:b].copy()))
+                hk = hs.reshape(-1, 3)[f].ravel()
+                self.reps.append((rec[a:b, :3].astype(np.int32), rec[a:b, 3:6].ravel().astype(np.int32),
+                                  hk if hk.any() else None, level.face_sharp[f].copy(), cv[va:vb].copy(),
+                                  norm[a:b].copy()))
+                self._rep_bytes += 400 + 90 * (b - a)
                 self.parity.append(parity)
             ids[i] = kid
         n = self.n_keys
@@ -164,10 +179,10 @@ class PatchTable:
         nv = np.array([len(r[4]) for r in reps], np.int64)
         foff = np.concatenate([[0], np.cumsum(nf)])
         voff = np.concatenate([[0], np.cumsum(nv)])
-        F = np.concatenate([r[0] for r in reps]) + np.repeat(voff[:-1], nf)[:, None]
-        tw = np.concatenate([r[1] for r in reps])
+        F = np.concatenate([r[0] for r in reps]).astype(np.int64) + np.repeat(voff[:-1], nf)[:, None]
+        tw = np.concatenate([r[1] for r in reps]).astype(np.int64)
         tw = np.where(tw >= 0, tw + 3 * np.repeat(foff[:-1], 3 * nf), -1)
-        hs = np.concatenate([r[2] for r in reps])
+        hs = np.concatenate([np.zeros(3 * len(r[0])) if r[2] is None else r[2] for r in reps])
         level = Level(F, int(voff[-1]), tw, hs if hs.any() else None, np.concatenate([r[3] for r in reps]))
         uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(keys), axis=0)
         p = Patches(level, np.concatenate([r[4] for r in reps]), np.concatenate([r[5] for r in reps]),
@@ -201,17 +216,15 @@ class PatchTable:
         return out
 
     def fill_steps(self, keys: np.ndarray):
-        """The candidates of ``keys`` (unique, not refined yet): their maps ``M`` and ``G``."""
+        """The candidates of ``keys`` (unique, not refined yet): their maps ``M``."""
         for r in self._refined(keys):
             X = r["p"].shape[r["p"].face]  # (k, 3, 2)
             cid, cc = r["cid"], r["ccorn"]
             M = np.swapaxes(barycentric(cc[:, :, None], X[:, None, :, :]), 2, 3)  # (k, 24, 3 bary, 3 corners)
-            G = barycentric(X[:, None, None], cc)  # (k, 24, 3 child corners, 3)
             valid = cid >= 0
             cnt = valid.sum(axis=1)
             kk, jj = np.nonzero(valid)
             start = self.M.append(M[kk, jj])
-            self.G.append(G[kk, jj])
             self.child.append(np.full(len(kk), -1))
             self.owner.append(r["keys"][kk])
             self.slot.append(jj)
@@ -223,10 +236,11 @@ class PatchTable:
     def fill_children(self, cands: np.ndarray):
         """Cut the child patches of the candidates ``cands`` (unique): their keys and ``T``."""
         owners = self.owner.a[cands]
-        recent = self._recent or []
+        recent = list(self._recent or [])
         have = np.concatenate([r["keys"] for r in recent]) if recent else np.zeros(0, np.int64)
-        if not np.isin(owners, have).all():
-            recent = self._refined(np.unique(owners))
+        other = ~np.isin(owners, have)
+        if other.any():  # keys refined at an earlier level or call: again
+            recent += self._refined(np.unique(owners[other]))
         for r in recent:
             pick = np.isin(owners, r["keys"])
             if pick.any():

@@ -14,6 +14,8 @@ from .walk import StartKeys, walk_rows
 
 #: Points followed down together (bounds the memory of one pass).
 CHUNK = 20000
+#: The patch cache is emptied between chunks once it holds about this many bytes.
+CACHE_BYTES = 2**29
 
 
 def _default_depth(scheme: str) -> int:
@@ -70,8 +72,7 @@ class LimitSurface:
             raise ValueError(f"depth must be a non-negative integer, got {depth!r}")
         self.depth = int(depth) + (int(depth) % 2 if scheme == "sqrt3" else 0)  # Kobbelt: even levels
         self._tol, self._max_levels = 1e-12, 60
-        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels)
-        self._starts = StartKeys(self._inp, self._table)
+        self._new_cache()
 
     @property
     def vertices(self) -> np.ndarray:
@@ -110,6 +111,11 @@ class LimitSurface:
         b = np.clip(b, 0.0, None)
         return f, b / b.sum(axis=1, keepdims=True)
 
+    def _new_cache(self):
+        """An empty patch cache (``_refiner/limit/cache.py``): filled as points are evaluated."""
+        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels)
+        self._starts = StartKeys(self._inp, self._table)
+
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         return walk_rows(self._table, self._starts, f, b, [1, 3, 6][int(derivatives)], depth)
 
@@ -146,6 +152,8 @@ class LimitSurface:
     def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         parts = [[] for _ in range([1, 3, 6][int(derivatives)])]
         for i in range(0, len(f), CHUNK):
+            if self._table.nbytes > CACHE_BYTES:
+                self._new_cache()
             for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
                 acc.append(R)
         n = self._inp.n_vertices

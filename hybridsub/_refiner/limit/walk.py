@@ -53,7 +53,7 @@ def _pick(table: PatchTable, key, bary, uv):
         table.fill_steps(lack)
     chosen = np.empty(len(key), np.int64)
     nb, nuv = np.empty_like(bary), np.empty_like(uv)
-    pick_children(key, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a, table.G.a, chosen, nb, nuv)
+    pick_children(key, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a, chosen, nb, nuv)
     miss = table.child.a[chosen] < 0
     if miss.any():
         table.fill_children(np.unique(chosen[miss]))
