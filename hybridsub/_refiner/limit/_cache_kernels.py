@@ -11,6 +11,9 @@ import numpy as np
 
 from ..._jit import kernel
 
+#: Candidates whose smallest barycentric coordinates differ by less are a tie.
+TIE = 1e-14
+
 
 @kernel
 def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart):
@@ -106,7 +109,8 @@ def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, fstart,
 @kernel
 def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv_out):
     """One level of the walk: every point's child face among its key's candidates (the
-    largest smallest barycentric coordinate, the first of equals), its coordinates there and
+    largest smallest barycentric coordinate; the first of those equal to ``TIE``, so a
+    point on an edge stays on the centre face's side), its coordinates there and
     the child's corners in (u, v). ``M`` (c, 3, 3) takes a point's barycentric coordinates
     into each candidate's; its inverse transposed holds the candidate's corners over the
     face. ``chosen`` gets the candidate, −1 where the key has no candidates yet."""
@@ -123,7 +127,7 @@ def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv
             for i in range(3):
                 b[i] = M[j, i, 0] * bary[q, 0] + M[j, i, 1] * bary[q, 1] + M[j, i, 2] * bary[q, 2]
                 lo = min(lo, b[i])
-            if lo > best:
+            if lo > best + TIE:
                 best = lo
                 chosen[q] = j
                 bary_out[q, :] = b

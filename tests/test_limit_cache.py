@@ -1,0 +1,86 @@
+"""The patch cache behind LimitSurface (issue 14's speed): the cached walk gives the direct
+descent's rows, whatever the numbering, orientation or order of evaluation."""
+
+import numpy as np
+import pytest
+from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
+
+import hybridsub
+from hybridsub._refiner.limit.descent import direct_rows
+
+
+def _points(F, k, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.integers(0, len(F), k), rng.dirichlet([1, 1, 1], k)
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_cached_walk_equals_the_direct_descent(name):
+    """Many keys (creases, corners, semi-sharp, darts, boundaries, Kobbelt's parity): the
+    cached rows are the direct descent's, to rounding (derivatives: to the last
+    interpolation's conditioning). Points inside faces: on an edge of some level the walk
+    keeps to the centre face's children where the direct descent takes whichever child
+    rounding favours, and the two agree to the interpolation's error only."""
+    V, F, kw = CASES[name]
+    s = hybridsub.LimitSurface(V, F, depth=7, **kw)
+    face, bary = _points(F, 60)
+    cached = s.evaluation_matrix(face, bary, derivatives=True)
+    f, b = s._points(face, bary)
+    direct = direct_rows(s._inp, f, b, 3, s.depth, 1e-12, 60)
+    P = direct[0] @ V
+    assert np.abs(cached[0] @ V - P).max() < 1e-13 * np.abs(P).max(), name
+    for Mc, Md in zip(cached[1:], direct[1:]):
+        D = Md @ V
+        assert np.abs(Mc @ V - D).max() < 1e-8 * np.abs(D).max(), name
+    assert s._table.n_keys > s.depth  # the walk met several patches per level
+
+
+def test_a_shared_cache_gives_what_a_fresh_one_gives():
+    V, F, kw = CASES["hybrid-crease"]
+    face, bary = _points(F, 40, seed=1)
+    warm = hybridsub.LimitSurface(V, F, depth=8, **kw)
+    warm.evaluate(*_points(F, 80, seed=2), derivatives=True)  # fills the cache with other points
+    n_before = warm._table.n_keys
+    got = warm.evaluate(face, bary, derivatives=True)
+    fresh = hybridsub.LimitSurface(V, F, depth=8, **kw).evaluate(face, bary, derivatives=True)
+    assert warm._table.n_keys < n_before + 40 * 8  # keys were found again
+    for a, b in zip(got, fresh):
+        assert np.abs(a - b).max() <= 1e-13 * np.abs(b).max()
+    again = warm.evaluate(face, bary, derivatives=True)  # every key known: same bits
+    for a, b in zip(got, again):
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("scheme", ["loop", "sqrt3", "hybrid"])
+def test_renumbered_rotated_and_mirrored_copies_give_the_same_surface(scheme):
+    """Two copies in one mesh: the second with its vertices renumbered, every face's corners
+    rotated, mirrored (faces reversed, x negated). Its patches hit the first copy's keys (or
+    their mirror images'), and the surface is the first copy's, mirrored."""
+    V, F = FAN_V, FAN_F
+    kw = {} if scheme == "sqrt3" else dict(sharp_edges=[[0, 2]])
+    n = len(V)
+    perm = np.random.default_rng(3).permutation(n)  # new id of each old vertex
+    V2 = np.empty_like(V)
+    V2[perm] = V * [-1, 1, 1] + [5, 0, 0]
+    F2 = perm[F[:, [1, 0, 2]]]  # reversed: corner order (1, 0, 2)
+    F2 = np.roll(F2, 1, axis=1)  # rotated: (2, 1, 0) of the original corners
+    VV, FF = np.vstack([V, V2]), np.vstack([F, F2 + n])
+    kw2 = {} if scheme == "sqrt3" else dict(sharp_edges=[[0, 2], [perm[0] + n, perm[2] + n]])
+    s = hybridsub.LimitSurface(VV, FF, scheme=scheme, depth=8, **kw2)
+    face, bary = _points(F, 50, seed=4)
+    P, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    Q = s.evaluate(face + len(F), bary[:, [2, 1, 0]])
+    assert np.abs(Q - (P * [-1, 1, 1] + [5, 0, 0])).max() < 1e-13
+    alone = hybridsub.LimitSurface(V, F, scheme=scheme, depth=8, **kw).evaluate(face, bary)
+    assert np.abs(alone - P).max() < 1e-13
+    assert s._table.n_keys < 2 * 8 * 50  # keys repeat
+
+
+def test_keys_repeat_in_regular_regions():
+    """Deep levels of a Loop surface meet few distinct patches: the cache is what makes the
+    walk cheap (a broken canonical order would make every patch new)."""
+    V, F = OCTA_V, OCTA_F
+    s = hybridsub.LimitSurface(V, F, scheme="loop", depth=10)
+    face, bary = _points(F, 200, seed=5)
+    s.evaluate(face, bary)
+    assert s._table.n_keys < 200 * 10 / 4
