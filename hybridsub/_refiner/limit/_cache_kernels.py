@@ -152,7 +152,7 @@ def back_rows(W, final, path, keys, nv, st_ids, st_L, st_L0, t_start, t_end, t_r
     times the stencil vertices' limit rows, then back through the recorded steps.
 
     ``final`` (q,) stencil record of the last key, ``path`` (q, d) the candidates chosen,
-    ``keys`` (q, d + 1) the keys met; ``out`` (q, r, nv_max) zeroed by the caller.
+    ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
     """
     nmax = 0
     for q in range(len(final)):
@@ -160,29 +160,28 @@ def back_rows(W, final, path, keys, nv, st_ids, st_L, st_L0, t_start, t_end, t_r
             nmax = max(nmax, nv[keys[q, lev]])
     nr = W.shape[1]
     d = path.shape[1]
-    cur = np.empty((nr, nmax))
-    nxt = np.empty((nr, nmax))
+    cur = np.empty((nmax, nr))
+    nxt = np.empty((nmax, nr))
     for q in range(len(final)):
         rec = final[q]
         n = nv[keys[q, d]]
-        cur[:, :n] = 0.0
+        cur[:n] = 0.0
         for j in range(6):
             if st_ids[rec, j] < 0:
                 continue
             base = st_L0[rec] + j * n
-            for r in range(nr):
-                w = W[q, r, j]
-                if w != 0.0:
-                    for v in range(n):
-                        cur[r, v] += w * st_L[base + v]
+            for v in range(n):
+                x = st_L[base + v]
+                if x != 0.0:
+                    for r in range(nr):
+                        cur[v, r] += W[q, r, j] * x
         for lev in range(d - 1, -1, -1):
             c = path[q, lev]
-            m = nv[keys[q, lev]]
-            nxt[:, :m] = 0.0
+            nxt[:nv[keys[q, lev]]] = 0.0
             for e in range(t_start[c], t_end[c]):
                 a, b, x = t_row[e], t_col[e], t_val[e]
                 for r in range(nr):
-                    nxt[r, b] += cur[r, a] * x
+                    nxt[b, r] += cur[a, r] * x
             cur, nxt = nxt, cur
         m = nv[keys[q, 0]]
-        out[q, :, :m] = cur[:, :m]
+        out[q, :m] = cur[:m]

@@ -84,17 +84,17 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     W = np.ascontiguousarray(np.stack(W[:n_rows], axis=1))
     nv = table.nv.a
     nv0 = nv[keys[:, 0]]
-    out = np.zeros((q, n_rows, int(nv0.max()) if q else 0))
+    out = np.zeros((q, int(nv0.max()) if q else 0, n_rows))
     back_rows(W, rec, path, keys, nv, table.st_ids.a, table.st_L.a, table.st_L0.a, table.t_start.a,
               table.t_end.a, table.t_row.a, table.t_col.a, table.t_val.a, out)
     # Onto the control vertices: each point's first patch in canonical order.
-    live = np.arange(out.shape[2])[None, :] < nv0[:, None]
-    cols = starts.vids.a[(starts.v0[f][:, None] + np.arange(out.shape[2])[None, :])[live]]
+    live = np.arange(out.shape[1])[None, :] < nv0[:, None]
+    cols = starts.vids.a[(starts.v0[f][:, None] + np.arange(out.shape[1])[None, :])[live]]
     indptr = np.concatenate([[0], np.cumsum(nv0)])
     n = starts.inp.n_vertices
     mats = []
     for r in range(n_rows):
-        M = sp.csr_matrix((out[:, r][live], cols, indptr), shape=(q, n))
+        M = sp.csr_matrix((out[:, :, r][live], cols, indptr), shape=(q, n))
         M.sort_indices()
         mats.append(M)
     return mats
