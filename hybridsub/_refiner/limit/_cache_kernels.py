@@ -185,3 +185,98 @@ def back_rows(W, final, path, keys, nv, st_ids, st_L, st_L0, t_start, t_end, t_r
             cur, nxt = nxt, cur
         m = nv[keys[q, 0]]
         out[q, :m] = cur[:m]
+
+
+@kernel
+def stencil_points(rec, bary, uv, inv, full, node, W):
+    """``descent.stencil_weights`` per point from a stencil record ``rec``: ``inv`` (s, 6, 6)
+    the inverse of each record's interpolation matrix, ``full`` whether it is used (else
+    linear), ``node`` (s, 9) the face's centroid (2), size (1) and corners (6). Fills ``W``
+    (q, r, 6): value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v², the first r of them."""
+    nr = W.shape[1]
+    rhs = np.empty((6, 6))
+    w = np.empty((6, 6))
+    J = np.empty((2, 2))
+    for q in range(len(rec)):
+        k = rec[q]
+        sc = node[k, 2]
+        xs = (bary[q, 0] * node[k, 3] + bary[q, 1] * node[k, 5] + bary[q, 2] * node[k, 7] - node[k, 0]) / sc
+        xt = (bary[q, 0] * node[k, 4] + bary[q, 1] * node[k, 6] + bary[q, 2] * node[k, 8] - node[k, 1]) / sc
+        e1s, e1t = node[k, 5] / sc - node[k, 3] / sc, node[k, 6] / sc - node[k, 4] / sc
+        e2s, e2t = node[k, 7] / sc - node[k, 3] / sc, node[k, 8] / sc - node[k, 4] / sc
+        w[:] = 0.0
+        if full[k]:
+            rhs[:] = 0.0
+            rhs[0, 0], rhs[1, 0], rhs[2, 0], rhs[3, 0], rhs[4, 0], rhs[5, 0] = 1.0, xs, xt, xs * xs, xs * xt, xt * xt
+            rhs[1, 1], rhs[3, 1], rhs[4, 1] = 1.0, 2 * xs, xt
+            rhs[2, 2], rhs[4, 2], rhs[5, 2] = 1.0, xs, 2 * xt
+            rhs[3, 3], rhs[4, 4], rhs[5, 5] = 2.0, 1.0, 2.0
+            for i in range(6):  # w = A⁻ᵀ rhs
+                for c in range(6):
+                    acc = 0.0
+                    for j in range(6):
+                        acc += inv[k, j, i] * rhs[j, c]
+                    w[i, c] = acc
+        else:  # linear: rows of the inverse of (e1 e2) are d bary1,2 / d(s, t)
+            det = e1s * e2t - e2s * e1t
+            w[0, 0], w[1, 0], w[2, 0] = bary[q, 0], bary[q, 1], bary[q, 2]
+            w[1, 1], w[1, 2] = e2t / det, -e2s / det
+            w[2, 1], w[2, 2] = -e1t / det, e1s / det
+            w[0, 1], w[0, 2] = -(w[1, 1] + w[2, 1]), -(w[1, 2] + w[2, 2])
+        top = 0
+        for c in range(1, 3):
+            if bary[q, c] > bary[q, top]:
+                top = c
+        if bary[q, top] >= 1.0 - 1e-14:  # at a vertex: its limit position exactly
+            for i in range(6):
+                w[i, 0] = 0.0
+            w[top, 0] = 1.0
+        # J = ∂(s,t)/∂(u,v) = (e1 e2) (uv1 − uv0, uv2 − uv0)⁻¹
+        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
+        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
+        dt = a * d_ - b * c_
+        i00, i01, i10, i11 = d_ / dt, -b / dt, -c_ / dt, a / dt
+        J[0, 0], J[0, 1] = e1s * i00 + e2s * i10, e1s * i01 + e2s * i11
+        J[1, 0], J[1, 1] = e1t * i00 + e2t * i10, e1t * i01 + e2t * i11
+        for i in range(6):
+            W[q, 0, i] = w[i, 0]
+            if nr > 1:
+                W[q, 1, i] = w[i, 1] * J[0, 0] + w[i, 2] * J[1, 0]
+                W[q, 2, i] = w[i, 1] * J[0, 1] + w[i, 2] * J[1, 1]
+            if nr > 3:
+                for o, (r1, r2) in enumerate(((0, 0), (0, 1), (1, 1))):
+                    acc = 0.0
+                    for p in range(2):
+                        for s in range(2):
+                            acc += J[p, r1] * w[i, 3 + p + s] * J[s, r2]
+                    W[q, 3 + o, i] = acc
+
+
+@kernel(inline="always")
+def _mix(z):
+    """splitmix64's finaliser: every input bit moves every output bit."""
+    z = z + np.uint64(0x9E3779B97F4A7C15)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@kernel
+def key_hashes(rec, fstart, cv, vstart, parity, out):
+    """A 128-bit hash of every piece's key (two independently seeded chains over its face
+    records, its vertices' corner flags, its sizes and the step parity): ``out`` (k, 2)."""
+    for i in range(len(fstart) - 1):
+        h1 = _mix(np.uint64(parity) ^ np.uint64(0x243F6A8885A308D3))
+        h2 = _mix(np.uint64(parity) ^ np.uint64(0x13198A2E03707344))
+        for r in range(fstart[i], fstart[i + 1]):
+            for c in range(rec.shape[1]):
+                w = np.uint64(rec[r, c])
+                h1 = _mix(h1 ^ w)
+                h2 = _mix(h2 + w * np.uint64(0xA4093822299F31D1))
+        for v in range(vstart[i], vstart[i + 1]):
+            w = np.uint64(cv[v])
+            h1 = _mix(h1 ^ w)
+            h2 = _mix(h2 + w * np.uint64(0xA4093822299F31D1))
+        n = np.uint64(fstart[i + 1] - fstart[i]) << np.uint64(32) | np.uint64(vstart[i + 1] - vstart[i])
+        out[i, 0] = _mix(h1 ^ n)
+        out[i, 1] = _mix(h2 + n)

@@ -24,14 +24,12 @@ representatives.
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
 
 from ..._topology import Level, child_level, face_parents, plan_step
 from ..chart import barycentric, child_shapes, plan_supports
 from ..stencils import step_matrix
-from ._cache_kernels import canonical_order, face_records
+from ._cache_kernels import canonical_order, face_records, key_hashes
 from .descent import Patches, _candidates, cut_patches, limit_rows, ring_faces, stencil_nodes
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
@@ -101,7 +99,7 @@ class PatchTable:
     def __init__(self, scheme: str, loop_weights: str, tol: float = 1e-12, max_levels: int = 60):
         self.scheme, self.loop_weights = scheme, loop_weights
         self.tol, self.max_levels = tol, max_levels
-        self.index: dict[bytes, int] = {}
+        self.index: dict[tuple, int] = {}  # key hash → key id
         self.reps: list[tuple] = []  # per key: F, twin, hsharp, face_sharp, corner, shape (canonical)
         self.parity: list[int] = []  # per key: 1 when the next step is odd ("sqrt3" only)
         self.nv = Grow((), np.int64)
@@ -122,7 +120,7 @@ class PatchTable:
         self.st_L0 = Grow((), np.int64)
         self.st_node = Grow((9,))  # c0 (2), scale (1), the face's corners (6)
         self.st_full = Grow((), np.bool_)
-        self.st_A = Grow((6, 6))
+        self.st_inv = Grow((6, 6))  # the inverse of the interpolation matrix
         self._recent = None
         self._rep_bytes = 0
 
@@ -142,23 +140,17 @@ class PatchTable:
         fperm, vperm, vstart, rec, norm = canonicalise(level, corner, shape, centre, fstart)
         hs = np.zeros(3 * level.n_faces) if level.hsharp is None else level.hsharp
         cv = corner[vperm]
+        h = np.empty((len(centre), 2), np.uint64)  # 128 bits: a collision is not a practical concern
+        key_hashes(rec, fstart, cv.astype(np.int64), vstart, parity, h)
         ids = np.empty(len(centre), np.int64)
-        pre = bytes([parity])
-        for i in range(len(centre)):
-            a, b = fstart[i], fstart[i + 1]
-            va, vb = vstart[i], vstart[i + 1]
-            h = hashlib.blake2b(pre, digest_size=16)  # 128 bits: a collision is not a practical concern
-            h.update(rec[a:b].tobytes())
-            h.update(np.packbits(cv[va:vb]).tobytes())
-            h.update(int(vb - va).to_bytes(4, "little"))
-            key = h.digest()
+        for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):
             kid = self.index.get(key)
             if kid is None:
                 kid = self.index[key] = len(self.reps)
-                f = fperm[a:b]
-                hk = hs.reshape(-1, 3)[f].ravel()
+                a, b, va, vb = fstart[i], fstart[i + 1], vstart[i], vstart[i + 1]
+                hk = hs[3 * fperm[a:b, None] + np.arange(3)].ravel()
                 self.reps.append((rec[a:b, :3].astype(np.int32), rec[a:b, 3:6].ravel().astype(np.int32),
-                                  hk if hk.any() else None, level.face_sharp[f].copy(), cv[va:vb].copy(),
+                                  hk if hk.any() else None, level.face_sharp[fperm[a:b]], cv[va:vb].copy(),
                                   norm[a:b].copy()))
                 self._rep_bytes += 400 + 90 * (b - a)
                 self.parity.append(parity)
@@ -281,7 +273,7 @@ class PatchTable:
         needed = np.unique(ids[ids >= 0])
         L = limit_rows(p, needed, self.scheme, self.loop_weights, self.tol, self.max_levels)
         rec = self.st_ids.append(np.where(ids >= 0, ids - voff[:-1, None], -1))
-        self.st_A.append(A)
+        self.st_inv.append(np.linalg.inv(A))
         self.st_full.append(full)
         self.st_node.append(np.concatenate([c0.reshape(-1, 2), scale.reshape(-1, 1), here.reshape(-1, 6)], axis=1))
         nv = np.diff(voff)

@@ -15,9 +15,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput
-from ._cache_kernels import back_rows, pick_children
+from ._cache_kernels import back_rows, pick_children, stencil_points
 from .cache import Grow, PatchTable
-from .descent import ring_faces, start, stencil_weights
+from .descent import ring_faces, start
 
 
 class StartKeys:
@@ -78,10 +78,8 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     if len(lack):
         table.fill_stencils(lack)
     rec = table.final.a[last]
-    node = table.st_node.a[rec]
-    W = stencil_weights(table.st_A.a[rec], table.st_full.a[rec], node[:, :2], node[:, 2:3],
-                        node[:, 3:].reshape(-1, 3, 2), uv, bary)
-    W = np.ascontiguousarray(np.stack(W[:n_rows], axis=1))
+    W = np.empty((q, n_rows, 6))
+    stencil_points(rec, bary, uv, table.st_inv.a, table.st_full.a, table.st_node.a, W)
     nv = table.nv.a
     nv0 = nv[keys[:, 0]]
     out = np.zeros((q, int(nv0.max()) if q else 0, n_rows))
