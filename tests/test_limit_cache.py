@@ -23,6 +23,7 @@ def test_cached_walk_equals_the_direct_descent(name):
     rounding favours, and the two agree to the interpolation's error only."""
     V, F, kw = CASES[name]
     s = hybridsub.LimitSurface(V, F, depth=7, **kw)
+    s._table.regular_stop = False  # every point all the way down, as the direct descent
     face, bary = _points(F, 60)
     cached = s.evaluation_matrix(face, bary, derivatives=True)
     f, b = s._points(face, bary)
@@ -84,3 +85,40 @@ def test_keys_repeat_in_regular_regions():
     face, bary = _points(F, 200, seed=5)
     s.evaluate(face, bary)
     assert s._table.n_keys < 200 * 10 / 4
+
+
+def _torus(n=6, seed=6):
+    """A closed n × n torus grid, every vertex of valence 6 (regular Loop everywhere), jittered."""
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    a, b = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / n
+    V = np.stack([(2 + np.cos(b)) * np.cos(a), (2 + np.cos(b)) * np.sin(a), np.sin(b)], 1)
+    V += 0.05 * np.random.default_rng(seed).standard_normal(V.shape)
+    idx = lambda x, y: (x % n) * n + y % n  # noqa: E731
+    F = [[idx(x, y), idx(x + 1, y), idx(x + 1, y + 1)] for x in range(n) for y in range(n)]
+    F += [[idx(x, y), idx(x + 1, y + 1), idx(x, y + 1)] for x in range(n) for y in range(n)]
+    return V, np.array(F)
+
+
+@pytest.mark.parametrize("mesh", ["torus", "octahedron"])
+def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
+    """The walk stops at regular Loop patches (every point of the torus at once, those of the
+    octahedron once away from its valence-4 vertices) and takes the box spline there: the
+    same surface as the walk to full depth, derivatives closer to the truth (exact)."""
+    V, F = _torus() if mesh == "torus" else (OCTA_V, OCTA_F)
+    face, bary = _points(F, 80, seed=7)
+    s = hybridsub.LimitSurface(V, F, scheme="loop")
+    P, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    deep = hybridsub.LimitSurface(V, F, scheme="loop", depth=20)
+    deep._table.regular_stop = False
+    Pd, Dud, Dvd = deep.evaluate(face, bary, derivatives=True)
+    assert np.abs(P - Pd).max() < 1e-13 * np.abs(Pd).max()
+    scale = np.abs(Dud).max()
+    assert np.abs(Du - Dud).max() < 1e-6 * scale and np.abs(Dv - Dvd).max() < 1e-6 * scale
+    # Central differences of the quartic: its derivatives to the differences' own error.
+    h = 1e-4
+    inside = (bary[:, 1:] > 2 * h).all(axis=1) & (bary[:, 0] > 2 * h)
+    shift = np.array([-1.0, 1.0, 0.0]) * h
+    fd = (s.evaluate(face[inside], bary[inside] + shift) - s.evaluate(face[inside], bary[inside] - shift)) / (2 * h)
+    assert np.abs(fd - Du[inside]).max() < 1e-6 * scale
+    if mesh == "torus":
+        assert s._table.regular.a[:s._table.n_keys].max() == 1 and (s._table.poly.a[:s._table.n_keys] >= 0).any()

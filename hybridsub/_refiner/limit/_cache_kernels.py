@@ -147,29 +147,27 @@ def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv
 
 
 @kernel
-def back_rows(W, final, path, keys, nv, st_ids, st_L, st_L0, t_start, t_end, t_row, t_col, t_val, out):
-    """Every point's rows over its first patch's vertices: the stencil weights ``W`` (q, r, 6)
-    times the stencil vertices' limit rows, then back through the recorded steps.
+def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row, t_col, t_val, out):
+    """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
+    last patch's ``slots`` (q,) rows (stencil vertices' limit rows, or a quartic's
+    coefficients) stored at ``st_L[block:]`` (slots × nv), then back through the steps.
 
-    ``final`` (q,) stencil record of the last key, ``path`` (q, d) the candidates chosen,
+    ``stop`` (q,) the level each point stopped at, ``path`` (q, d) the candidates chosen,
     ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
     """
     nmax = 0
-    for q in range(len(final)):
-        for lev in range(keys.shape[1]):
+    for q in range(len(stop)):
+        for lev in range(stop[q] + 1):
             nmax = max(nmax, nv[keys[q, lev]])
     nr = W.shape[1]
-    d = path.shape[1]
     cur = np.empty((nmax, nr))
     nxt = np.empty((nmax, nr))
-    for q in range(len(final)):
-        rec = final[q]
+    for q in range(len(stop)):
+        d = stop[q]
         n = nv[keys[q, d]]
         cur[:n] = 0.0
-        for j in range(6):
-            if st_ids[rec, j] < 0:
-                continue
-            base = st_L0[rec] + j * n
+        for j in range(slots[q]):
+            base = block[q] + j * n
             for v in range(n):
                 x = st_L[base + v]
                 if x != 0.0:

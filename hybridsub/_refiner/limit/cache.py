@@ -31,6 +31,7 @@ from ..chart import barycentric, child_shapes, plan_supports
 from ..stencils import step_matrix
 from ._cache_kernels import canonical_order, face_records, key_hashes
 from .descent import Patches, _candidates, cut_patches, limit_rows, ring_faces, stencil_nodes
+from .regular import is_regular
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
 GRID = 1e-9
@@ -115,6 +116,9 @@ class PatchTable:
         self.t_col = Grow((), np.int32)
         self.t_val = Grow(())
         self.final = Grow((), np.int64, -1)  # per key: its stencil record (−1: none yet)
+        self.regular_stop = scheme != "sqrt3"  # stop at regular Loop patches (regular.py)
+        self.regular = Grow((), np.int8, -1)  # per key: 1 a regular Loop patch, 0 not, −1 not known yet
+        self.poly = Grow((), np.int64, -1)  # per regular key: its quartic's coefficients in st_L
         self.st_ids = Grow((6,), np.int64)  # per stencil record
         self.st_L = Grow((), np.float64)  # limit rows of the six vertices, 6 × nv, from st_L0
         self.st_L0 = Grow((), np.int64)
@@ -156,12 +160,20 @@ class PatchTable:
                 self.parity.append(parity)
             ids[i] = kid
         n = self.n_keys
-        for g in (self.cand_start, self.final):
+        for g in (self.cand_start, self.final, self.regular, self.poly):
             g.extend_to(n)
         self.cand_count.extend_to(n)
         if self.nv.n < n:
             self.nv.append([len(self.reps[j][4]) for j in range(self.nv.n, n)])
         return ids, vperm, vstart
+
+    def regular_keys(self, keys: np.ndarray) -> np.ndarray:
+        """Whether each key is a regular Loop patch (:func:`.regular.is_regular`)."""
+        flag = self.regular.a[keys]
+        for k in np.unique(keys[flag < 0]):
+            F, twin, hs, fs, corner, _ = self.reps[k]
+            self.regular.a[k] = is_regular(F, twin, hs, fs, corner)
+        return self.regular.a[keys] == 1
 
     def patches(self, keys: np.ndarray):
         """The representatives of ``keys`` as one mesh of disjoint pieces; also the face and

@@ -18,6 +18,7 @@ from ..._input import RefineInput
 from ._cache_kernels import back_rows, pick_children, stencil_points
 from .cache import Grow, PatchTable
 from .descent import ring_faces, start
+from .regular import GRID, GRID_INVERSE, polynomial_weights
 
 
 class StartKeys:
@@ -60,32 +61,83 @@ def _pick(table: PatchTable, key, bary, uv):
     return chosen, nb, nuv
 
 
+def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool):
+    """Every point down to ``depth`` levels, or to the first regular Loop patch (with
+    ``stop_regular``). Returns the keys met (q, depth + 1), the candidates chosen (q, depth),
+    the level each point stopped at, and its barycentric coordinates and (u, v) corners there."""
+    q = len(keys0)
+    keys = np.empty((q, depth + 1), np.int64)
+    path = np.empty((q, depth), np.int64)
+    stop = np.full(q, depth, np.int64)
+    keys[:, 0] = keys0
+    live = np.arange(q)
+    for lev in range(depth + 1):
+        if stop_regular:
+            reg = table.regular_keys(keys[live, lev])
+            stop[live[reg]] = lev
+            live = live[~reg]
+        if lev == depth or not len(live):
+            break
+        path[live, lev], bary[live], uv[live] = _pick(table, keys[live, lev], bary[live], uv[live])
+        keys[live, lev + 1] = table.child.a[path[live, lev]]
+    return keys, path, stop, bary, uv
+
+
+def walk(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
+    """Rows (q, nv_max, n_rows) of the points over their first patches' canonical vertices:
+    value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v²."""
+    q = len(keys0)
+    keys, path, stop, bary, uv = _descend(table, keys0, bary.copy(), uv.copy(), depth, stop_regular)
+    last = keys[np.arange(q), stop]
+    poly = table.regular_keys(last) if stop_regular else np.zeros(q, bool)
+    W = np.zeros((q, n_rows, 15))
+    block = np.empty(q, np.int64)
+    if poly.any():
+        uk = np.unique(last[poly])
+        fill_polynomials(table, uk[table.poly.a[uk] < 0])
+        block[poly] = table.poly.a[last[poly]]
+        W[poly] = polynomial_weights(bary[poly], uv[poly], n_rows)
+    st = np.flatnonzero(~poly)
+    if len(st):
+        uk = np.unique(last[st])
+        lack = uk[table.final.a[uk] < 0]
+        if len(lack):
+            table.fill_stencils(lack)
+        rec = table.final.a[last[st]]
+        Ws = np.empty((len(st), n_rows, 6))
+        stencil_points(rec, bary[st], uv[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
+        W[st, :, :6] = Ws
+        block[st] = table.st_L0.a[rec]
+    nv = table.nv.a
+    out = np.zeros((q, int(nv[keys0].max()) if q else 0, n_rows))
+    back_rows(W, np.where(poly, 15, 6), block, stop, path, keys, nv, table.st_L.a, table.t_start.a,
+              table.t_end.a, table.t_row.a, table.t_col.a, table.t_val.a, out)
+    return out
+
+
+def fill_polynomials(table: PatchTable, keys: np.ndarray):
+    """The quartic of each regular Loop patch in ``keys`` (:mod:`.regular`): its 15 Bernstein
+    coefficients as rows over the patch's vertices, from the exact limit rows at ``GRID``."""
+    if not len(keys):
+        return
+    k = len(keys)
+    uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], 15 * k, axis=0)
+    rows = walk(table, np.repeat(keys, 15), np.tile(GRID, (k, 1)), uv, 1, 2, False)[:, :, 0]
+    coef = GRID_INVERSE @ rows.reshape(k, 15, -1)  # (k, 15, nv_max)
+    nv = table.nv.a[keys]
+    table.poly.a[keys] = table.st_L.n + np.concatenate([[0], np.cumsum(15 * nv)[:-1]])
+    table.st_L.append(np.concatenate([coef[i, :, :nv[i]].ravel() for i in range(k)]))
+
+
 def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
     """Rows over the control vertices of the points (face ``f``, bary ``b``): value, then
     ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR matrix)."""
     q = len(f)
-    keys = np.empty((q, depth + 1), np.int64)
-    path = np.empty((q, depth), np.int64)
-    keys[:, 0] = starts.of(f)
-    bary = b.copy()
+    keys0 = starts.of(f)
     uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
-    for lev in range(depth):
-        path[:, lev], bary, uv = _pick(table, keys[:, lev], bary, uv)
-        keys[:, lev + 1] = table.child.a[path[:, lev]]
-    last = keys[:, depth]
-    uk = np.unique(last)
-    lack = uk[table.final.a[uk] < 0]
-    if len(lack):
-        table.fill_stencils(lack)
-    rec = table.final.a[last]
-    W = np.empty((q, n_rows, 6))
-    stencil_points(rec, bary, uv, table.st_inv.a, table.st_full.a, table.st_node.a, W)
-    nv = table.nv.a
-    nv0 = nv[keys[:, 0]]
-    out = np.zeros((q, int(nv0.max()) if q else 0, n_rows))
-    back_rows(W, rec, path, keys, nv, table.st_ids.a, table.st_L.a, table.st_L0.a, table.t_start.a,
-              table.t_end.a, table.t_row.a, table.t_col.a, table.t_val.a, out)
+    out = walk(table, keys0, b, uv, n_rows, depth, table.regular_stop)
     # Onto the control vertices: each point's first patch in canonical order.
+    nv0 = table.nv.a[keys0]
     live = np.arange(out.shape[1])[None, :] < nv0[:, None]
     cols = starts.vids.a[(starts.v0[f][:, None] + np.arange(out.shape[1])[None, :])[live]]
     indptr = np.concatenate([[0], np.cumsum(nv0)])
