@@ -122,3 +122,24 @@ def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
     assert np.abs(fd - Du[inside]).max() < 1e-6 * scale
     if mesh == "torus":
         assert s._table.regular.a[:s._table.n_keys].max() == 1 and (s._table.poly.a[:s._table.n_keys] >= 0).any()
+
+
+def test_quartic_kernel_matches_its_definition():
+    """quartic_points (the walk's kernel) == the Bernstein basis of regular.bernstein, chained
+    to (u, v) by hand."""
+    from hybridsub._refiner.limit.regular import bernstein, polynomial_weights
+
+    rng = np.random.default_rng(8)
+    bary = rng.dirichlet([1, 1, 1], 20)
+    uv = rng.standard_normal((20, 3, 2))
+    W = polynomial_weights(bary, uv, 6)
+    B = bernstein(bary, 2)
+    G = np.linalg.inv(np.stack([uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]], -1))
+    assert np.allclose(W[:, 0], B[0], rtol=0, atol=1e-14)
+    assert np.allclose(W[:, 1], B[1] * G[:, None, 0, 0] + B[2] * G[:, None, 1, 0], rtol=1e-12, atol=1e-12)
+    assert np.allclose(W[:, 2], B[1] * G[:, None, 0, 1] + B[2] * G[:, None, 1, 1], rtol=1e-12, atol=1e-12)
+    H = np.array([[B[3], B[4]], [B[4], B[5]]])  # (2, 2, q, 15)
+    Huv = np.einsum("qai,abqt,qbj->qtij", G, H, G)
+    for o, (r1, r2) in enumerate(((0, 0), (0, 1), (1, 1))):
+        assert np.allclose(W[:, 3 + o], Huv[:, :, r1, r2], rtol=1e-12, atol=1e-10)
+    assert np.allclose(B[0].sum(axis=1), 1.0)  # a partition of unity

@@ -278,3 +278,45 @@ def key_hashes(rec, fstart, cv, vstart, parity, out):
         n = np.uint64(fstart[i + 1] - fstart[i]) << np.uint64(32) | np.uint64(vstart[i + 1] - vstart[i])
         out[i, 0] = _mix(h1 ^ n)
         out[i, 1] = _mix(h2 + n)
+
+
+@kernel
+def quartic_points(bary, uv, exps, coef, W):
+    """``regular.polynomial_weights``: the quartic Bernstein basis ``coef`` · b^``exps`` (15)
+    at every point and its derivatives in (u, v) (``uv`` (q, 3, 2) the face's corners), into
+    ``W`` (q, r, 15): value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v², the first r of them."""
+    nr = W.shape[1]
+    pw = np.zeros((3, 7))  # pw[c, p + 2] = b_c ** p, zero for p < 0
+    G = np.empty((2, 2))
+    for q in range(len(bary)):
+        for c in range(3):
+            pw[c, 2] = 1.0
+            for p in range(1, 5):
+                pw[c, p + 2] = pw[c, p + 1] * bary[q, c]
+        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
+        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
+        dt = a * d_ - b * c_
+        G[0, 0], G[0, 1], G[1, 0], G[1, 1] = d_ / dt, -b / dt, -c_ / dt, a / dt  # ∂(b1, b2)/∂(u, v)
+        for t in range(15):
+            i, j, k = exps[t, 0], exps[t, 1], exps[t, 2]
+            f = coef[t]
+            W[q, 0, t] = f * pw[0, i + 2] * pw[1, j + 2] * pw[2, k + 2]
+            if nr == 1:
+                continue
+            d1 = f * (j * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 2] - i * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 2])
+            d2 = f * (k * pw[0, i + 2] * pw[1, j + 2] * pw[2, k + 1] - i * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 2])
+            W[q, 1, t] = d1 * G[0, 0] + d2 * G[1, 0]
+            W[q, 2, t] = d1 * G[0, 1] + d2 * G[1, 1]
+            if nr == 3:
+                continue
+            t00 = i * (i - 1) * pw[0, i] * pw[1, j + 2] * pw[2, k + 2]
+            h11 = f * (j * (j - 1) * pw[0, i + 2] * pw[1, j] * pw[2, k + 2]
+                       - 2 * i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
+            h12 = f * (j * k * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 1] - i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1]
+                       - i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
+            h22 = f * (k * (k - 1) * pw[0, i + 2] * pw[1, j + 2] * pw[2, k]
+                       - 2 * i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1] + t00)
+            for o in range(3):
+                r1, r2 = (0, 0) if o == 0 else ((0, 1) if o == 1 else (1, 1))
+                W[q, 3 + o, t] = (G[0, r1] * h11 * G[0, r2] + G[0, r1] * h12 * G[1, r2]
+                                  + G[1, r1] * h12 * G[0, r2] + G[1, r1] * h22 * G[1, r2])

@@ -15,6 +15,8 @@ from math import factorial
 
 import numpy as np
 
+from ._cache_kernels import quartic_points
+
 #: Exponents (i, j, k), i + j + k = 4, of the quartic Bernstein basis over (b0, b1, b2).
 EXPONENTS = np.array([(i, j, 4 - i - j) for i in range(4, -1, -1) for j in range(4 - i, -1, -1)])
 #: The vertices of the face's second refinement, barycentric.
@@ -53,19 +55,10 @@ GRID_INVERSE = np.linalg.inv(bernstein(GRID)[0])
 
 def polynomial_weights(bary: np.ndarray, uv: np.ndarray, n_rows: int) -> np.ndarray:
     """Weights (q, n_rows, 15) on the 15 coefficients: value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v,
-    ∂²/∂v²; ``uv`` (q, 3, 2) the face's corners in (u, v)."""
-    B = bernstein(bary, 0 if n_rows == 1 else 1 if n_rows == 3 else 2)
+    ∂²/∂v², from :func:`bernstein` and the face's corners in (u, v), ``uv`` (q, 3, 2)."""
     W = np.empty((len(bary), n_rows, 15))
-    W[:, 0] = B[0]
-    if n_rows > 1:
-        Mu = np.stack([uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]], -1)
-        G = np.linalg.inv(Mu)  # ∂(b1, b2)/∂(u, v)
-        W[:, 1] = B[1] * G[:, None, 0, 0] + B[2] * G[:, None, 1, 0]
-        W[:, 2] = B[1] * G[:, None, 0, 1] + B[2] * G[:, None, 1, 1]
-    if n_rows > 3:
-        H = [[B[3], B[4]], [B[4], B[5]]]
-        for o, (r1, r2) in enumerate(((0, 0), (0, 1), (1, 1))):
-            W[:, 3 + o] = sum(G[:, None, a, r1] * H[a][c] * G[:, None, c, r2] for a in range(2) for c in range(2))
+    quartic_points(np.ascontiguousarray(bary, dtype=np.float64), np.ascontiguousarray(uv, dtype=np.float64),
+                   EXPONENTS, _COEF, W)
     return W
 
 
