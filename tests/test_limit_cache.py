@@ -7,6 +7,7 @@ from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
 
 import hybridsub
 from hybridsub._refiner.limit.descent import direct_rows
+from hybridsub._refiner.limit.regular import is_regular
 
 
 def _points(F, k, seed=0):
@@ -120,8 +121,11 @@ def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
     shift = np.array([-1.0, 1.0, 0.0]) * h
     fd = (s.evaluate(face[inside], bary[inside] + shift) - s.evaluate(face[inside], bary[inside] - shift)) / (2 * h)
     assert np.abs(fd - Du[inside]).max() < 1e-6 * scale
+    t = s._table
+    flags = [is_regular(F_, tw, hs, fs, c) for F_, tw, hs, fs, c, _ in t.reps]  # the kernel's definition
+    assert np.array_equal(t.regular.a[:t.n_keys], np.array(flags, np.int8))
     if mesh == "torus":
-        assert s._table.regular.a[:s._table.n_keys].max() == 1 and (s._table.poly.a[:s._table.n_keys] >= 0).any()
+        assert t.regular.a[:t.n_keys].max() == 1 and (t.poly.a[:t.n_keys] >= 0).any()
 
 
 def test_quartic_kernel_matches_its_definition():

@@ -320,3 +320,38 @@ def quartic_points(bary, uv, exps, coef, W):
                 r1, r2 = (0, 0) if o == 0 else ((0, 1) if o == 1 else (1, 1))
                 W[q, 3 + o, t] = (G[0, r1] * h11 * G[0, r2] + G[0, r1] * h12 * G[1, r2]
                                   + G[1, r1] * h12 * G[0, r2] + G[1, r1] * h22 * G[1, r2])
+
+
+@kernel
+def regular_flags(rec, fstart, cv, vstart, out):
+    """``regular.is_regular`` of every piece from its canonical records (:func:`face_records`)
+    and corner flags ``cv``: ``out`` (k,) 1 or 0."""
+    for i in range(len(fstart) - 1):
+        a, b = fstart[i], fstart[i + 1]
+        va, vb = vstart[i], vstart[i + 1]
+        ok = True
+        for v in range(va, vb):
+            if cv[v]:
+                ok = False
+        count = np.zeros(vb - va, np.int64)
+        opened = np.zeros(vb - va, np.bool_)
+        for r in range(a, b):
+            if rec[r, 6] == 0 or rec[r, 7] != 0 or rec[r, 8] != 0 or rec[r, 9] != 0:
+                ok = False
+            for c in range(3):
+                count[rec[r, c]] += 1
+                if rec[r, 3 + c] < 0:
+                    opened[rec[r, c]] = True
+        if ok:
+            for r in range(a, b):  # the faces touching the centre (face a): their vertices
+                touches = False
+                for c in range(3):
+                    for e in range(3):
+                        if rec[r, c] == rec[a, e]:
+                            touches = True
+                if touches:
+                    for c in range(3):
+                        v = rec[r, c]
+                        if count[v] != 6 or opened[v]:
+                            ok = False
+        out[i] = 1 if ok else 0

@@ -29,9 +29,8 @@ import numpy as np
 from ..._topology import Level, child_level, face_parents, plan_step
 from ..chart import barycentric, child_shapes, plan_supports
 from ..stencils import step_matrix
-from ._cache_kernels import canonical_order, face_records, key_hashes
+from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
 from .descent import Patches, _candidates, cut_patches, limit_rows, ring_faces, stencil_nodes
-from .regular import is_regular
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
 GRID = 1e-9
@@ -117,7 +116,7 @@ class PatchTable:
         self.t_val = Grow(())
         self.final = Grow((), np.int64, -1)  # per key: its stencil record (−1: none yet)
         self.regular_stop = scheme != "sqrt3"  # stop at regular Loop patches (regular.py)
-        self.regular = Grow((), np.int8, -1)  # per key: 1 a regular Loop patch, 0 not, −1 not known yet
+        self.regular = Grow((), np.int8)  # per key: 1 a regular Loop patch (regular.is_regular), else 0
         self.poly = Grow((), np.int64, -1)  # per regular key: its quartic's coefficients in st_L
         self.st_ids = Grow((6,), np.int64)  # per stencil record
         self.st_L = Grow((), np.float64)  # limit rows of the six vertices, 6 × nv, from st_L0
@@ -146,6 +145,8 @@ class PatchTable:
         cv = corner[vperm]
         h = np.empty((len(centre), 2), np.uint64)  # 128 bits: a collision is not a practical concern
         key_hashes(rec, fstart, cv.astype(np.int64), vstart, parity, h)
+        reg = np.empty(len(centre), np.int8)
+        regular_flags(rec, fstart, cv, vstart, reg)
         ids = np.empty(len(centre), np.int64)
         for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):
             kid = self.index.get(key)
@@ -158,9 +159,10 @@ class PatchTable:
                                   norm[a:b].copy()))
                 self._rep_bytes += 400 + 90 * (b - a)
                 self.parity.append(parity)
+                self.regular.append([reg[i]])
             ids[i] = kid
         n = self.n_keys
-        for g in (self.cand_start, self.final, self.regular, self.poly):
+        for g in (self.cand_start, self.final, self.poly):
             g.extend_to(n)
         self.cand_count.extend_to(n)
         if self.nv.n < n:
@@ -169,10 +171,6 @@ class PatchTable:
 
     def regular_keys(self, keys: np.ndarray) -> np.ndarray:
         """Whether each key is a regular Loop patch (:func:`.regular.is_regular`)."""
-        flag = self.regular.a[keys]
-        for k in np.unique(keys[flag < 0]):
-            F, twin, hs, fs, corner, _ = self.reps[k]
-            self.regular.a[k] = is_regular(F, twin, hs, fs, corner)
         return self.regular.a[keys] == 1
 
     def patches(self, keys: np.ndarray):
