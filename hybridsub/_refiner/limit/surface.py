@@ -44,7 +44,10 @@ class LimitSurface:
     Points are ``(face, bary)``: ``bary = (1 − u − v, u, v)`` over ``F[face]``; ``∂/∂u``,
     ``∂/∂v`` follow OpenSubdiv's triangle convention (corner 0 at (0, 0), 1 at (1, 0), 2 at
     (0, 1)). Each point is followed through the refinement by exact local refinement with the
-    scheme's own rules, then interpolated from exact limit positions six vertices around it.
+    scheme's own rules, then interpolated from exact limit positions six vertices around it
+    (or, at a regular Loop patch, given by its exact quartic). Each distinct patch is refined
+    once and kept in the surface's patch cache: points near ones already evaluated cost table
+    look-ups (``docs/limit.md``).
 
     Examples
     --------
