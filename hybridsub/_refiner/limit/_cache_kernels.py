@@ -16,7 +16,7 @@ TIE = 1e-14
 
 
 @kernel
-def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart):
+def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart, entry):
     """Faces and vertices of every piece in a canonical order.
 
     Pieces are contiguous: node ``i`` owns faces ``fstart[i]:fstart[i + 1]`` (and the vertices
@@ -24,11 +24,11 @@ def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart):
     other face is entered at the halfedge it was reached through, and its neighbours are
     queued in corner order from there. Vertices are numbered as first met. Faces not reached
     through edges follow in their stored order. Fills ``fperm`` (faces in canonical order),
-    ``vperm`` (vertices in canonical order) and ``vstart`` (k + 1) their ranges per node.
+    ``vperm`` (vertices in canonical order), ``vstart`` (k + 1) their ranges per node and
+    ``entry`` (m) the corner each face was entered at.
     """
     m = len(F)
     fmark = np.zeros(m, np.bool_)
-    entry = np.zeros(m, np.int64)
     vseen = np.zeros(n, np.bool_)
     nv = 0
     for i in range(len(centre)):
@@ -70,8 +70,10 @@ def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart):
 
 
 @kernel
-def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, fstart, node_of, scale, grid, out, norm):
-    """Per canonical face: its canonical corners, twins, tags and normalised shape.
+def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, entry, fstart, node_of, scale, grid, out,
+                 norm):
+    """Per canonical face, its corners from the one it was entered at (``entry``): their
+    canonical labels, twins, tags and the normalised shape.
 
     ``out`` (m, 13) int64: corner labels (3), canonical twin halfedges (3, −1 none), sharp
     face (1), ``hbits`` of the halfedges (3: their sharpness's bits), and the shape normalised by a rigid
@@ -83,17 +85,20 @@ def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, fstart,
         f = fperm[r]
         i = node_of[r]
         base = fstart[i]
+        s0 = entry[f]
         for c in range(3):
-            out[r, c] = vrank[F[f, c]]
-            t = twin[3 * f + c]
-            out[r, 3 + c] = 3 * (frank[t // 3] - base) + t % 3 if t >= 0 else -1
-            out[r, 7 + c] = hbits[3 * f + c]
+            cc = (s0 + c) % 3
+            out[r, c] = vrank[F[f, cc]]
+            t = twin[3 * f + cc]
+            out[r, 3 + c] = 3 * (frank[t // 3] - base) + (t % 3 - entry[t // 3] + 3) % 3 if t >= 0 else -1
+            out[r, 7 + c] = hbits[3 * f + cc]
         out[r, 6] = 1 if face_sharp[f] else 0
-        ax, ay = shape[f, 0, 0], shape[f, 0, 1]
-        ex, ey = shape[f, 1, 0] - ax, shape[f, 1, 1] - ay
+        s1, s2 = (s0 + 1) % 3, (s0 + 2) % 3
+        ax, ay = shape[f, s0, 0], shape[f, s0, 1]
+        ex, ey = shape[f, s1, 0] - ax, shape[f, s1, 1] - ay
         ln = math.sqrt(ex * ex + ey * ey)
         co, si = ex / ln, ey / ln
-        dx, dy = shape[f, 2, 0] - ax, shape[f, 2, 1] - ay
+        dx, dy = shape[f, s2, 0] - ax, shape[f, s2, 1] - ay
         s = scale[i]
         norm[r, 0, 0] = 0.0
         norm[r, 0, 1] = 0.0

@@ -4,7 +4,7 @@ Below the first levels the patches of the descent (:mod:`.descent`) repeat: regu
 Loop neighbourhoods, crease and boundary sectors, the neighbourhood of an extraordinary
 vertex, each level's shapes the same up to a rigid motion and a scale. A patch is described
 by a *key*: its faces and vertices in a canonical order (breadth first from the centre face,
-entered at its corner 0), their connectivity, tags and shapes (each face's corners moved by a
+entered at its corner 0, each face's corners from the one it was entered at), their connectivity, tags and shapes (each face's corners moved by a
 rigid motion of its own, the whole patch scaled by the centre face's first edge, rounded to
 :data:`GRID`), and Kobbelt's step parity for ``"sqrt3"``. Two patches with one key are the
 same tagged mesh up to the numbering of their vertices, so one of them, the key's
@@ -70,14 +70,16 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
 
     Returns ``fperm``, ``vperm``, ``vstart`` (canonical faces and vertices, the vertex ranges
     per node), ``rec`` (m, 13) int64 per canonical face and ``norm`` (m, 3, 2) the normalised
-    shapes (see :func:`._cache_kernels.face_records`).
+    shapes, every face's corners from the one it was entered at (see
+    :func:`._cache_kernels.face_records`).
     """
     F = np.ascontiguousarray(level.faces, dtype=np.int64)
     m, k = len(F), len(centre)
     fperm, vperm = np.empty(m, np.int64), np.empty(level.n_vertices, np.int64)
     vstart = np.empty(k + 1, np.int64)
     twin = np.ascontiguousarray(level.twin, dtype=np.int64)
-    canonical_order(F, twin, level.n_vertices, fstart, centre, fperm, vperm, vstart)
+    entry = np.zeros(m, np.int64)
+    canonical_order(F, twin, level.n_vertices, fstart, centre, fperm, vperm, vstart, entry)
     frank = np.empty(m, np.int64)
     frank[fperm] = np.arange(m)
     node_f = np.repeat(np.arange(k), np.diff(fstart))
@@ -89,7 +91,7 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
     rec = np.empty((m, 13), np.int64)
     norm = np.empty((m, 3, 2))
     face_records(F, twin, hs.view(np.int64), level.face_sharp, np.ascontiguousarray(shape, dtype=np.float64), fperm,
-                 frank, vrank, fstart, node_f, scale, GRID, rec, norm)
+                 frank, vrank, entry, fstart, node_f, scale, GRID, rec, norm)
     return fperm, vperm, vstart, rec, norm
 
 
@@ -141,7 +143,6 @@ class PatchTable:
         """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
         the canonical vertex orders: ``vperm``, ``vstart``."""
         fperm, vperm, vstart, rec, norm = canonicalise(level, corner, shape, centre, fstart)
-        hs = np.zeros(3 * level.n_faces) if level.hsharp is None else level.hsharp
         cv = corner[vperm]
         h = np.empty((len(centre), 2), np.uint64)  # 128 bits: a collision is not a practical concern
         key_hashes(rec, fstart, cv.astype(np.int64), vstart, parity, h)
@@ -153,7 +154,7 @@ class PatchTable:
             if kid is None:
                 kid = self.index[key] = len(self.reps)
                 a, b, va, vb = fstart[i], fstart[i + 1], vstart[i], vstart[i + 1]
-                hk = hs[3 * fperm[a:b, None] + np.arange(3)].ravel()
+                hk = rec[a:b, 7:10].ravel().view(np.float64)  # the halfedges' sharpness, rotated
                 self.reps.append((rec[a:b, :3].astype(np.int32), rec[a:b, 3:6].ravel().astype(np.int32),
                                   hk if hk.any() else None, level.face_sharp[fperm[a:b]], cv[va:vb].copy(),
                                   norm[a:b].copy()))
