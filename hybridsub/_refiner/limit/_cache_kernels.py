@@ -317,7 +317,8 @@ def quartic_points(bary, uv, exps, coef, W):
             t00 = i * (i - 1) * pw[0, i] * pw[1, j + 2] * pw[2, k + 2]
             h11 = f * (j * (j - 1) * pw[0, i + 2] * pw[1, j] * pw[2, k + 2]
                        - 2 * i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
-            h12 = f * (j * k * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 1] - i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1]
+            h12 = f * (j * k * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 1]
+                       - i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1]
                        - i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
             h22 = f * (k * (k - 1) * pw[0, i + 2] * pw[1, j + 2] * pw[2, k]
                        - 2 * i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1] + t00)

@@ -4,17 +4,19 @@ Below the first levels the patches of the descent (:mod:`.descent`) repeat: regu
 Loop neighbourhoods, crease and boundary sectors, the neighbourhood of an extraordinary
 vertex, each level's shapes the same up to a rigid motion and a scale. A patch is described
 by a *key*: its faces and vertices in a canonical order (breadth first from the centre face,
-entered at its corner 0, each face's corners from the one it was entered at), their connectivity, tags and shapes (each face's corners moved by a
-rigid motion of its own, the whole patch scaled by the centre face's first edge, rounded to
-:data:`GRID`), and Kobbelt's step parity for ``"sqrt3"``. Two patches with one key are the
-same tagged mesh up to the numbering of their vertices, so one of them, the key's
-*representative*, stands for all: it is refined once with the project's own step
-(``descent.step``'s machinery) and what the walk needs is kept in flat tables:
+entered at its corner 0, each face's corners from the one it was entered at), their
+connectivity, tags and shapes (each face's corners moved by a rigid motion of its own, the
+whole patch scaled by the centre face's first edge, rounded to :data:`GRID`), and Kobbelt's
+step parity for ``"sqrt3"``. Two patches with one key are the same tagged mesh up to the
+numbering of their vertices, so one of them, the key's *representative*, stands for all: it
+is refined once with the project's own step (``descent.step``'s machinery) and what the
+walk needs is kept in flat tables:
 
 - per key, its candidate child faces (those ``descent.step`` chooses among), each with the
   map ``M`` of the point's barycentric coordinates into the child's (its inverse transposed
-  holds the child's corners over the centre face, to follow (u, v)) and, once a point has chosen it,
-  the child's key and the step's rows restricted to (child patch × patch) vertices ``T``;
+  holds the child's corners over the centre face, to follow (u, v)) and, once a point has
+  chosen it, the child's key and the step's rows restricted to (child patch × patch)
+  vertices ``T``;
 - per key ending a descent, the interpolation stencil's six vertices with their exact limit
   rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
 
@@ -30,7 +32,14 @@ from ..._topology import Level, child_level, face_parents, plan_step
 from ..chart import barycentric, child_shapes, plan_supports
 from ..stencils import step_matrix
 from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
-from .descent import Patches, _candidates, cut_patches, limit_rows, ring_faces, stencil_nodes
+from .descent import (
+    Patches,
+    _candidates,
+    cut_patches,
+    limit_rows,
+    ring_faces,
+    stencil_nodes,
+)
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
 GRID = 1e-9
@@ -194,7 +203,7 @@ class PatchTable:
 
     def _refine(self, keys: np.ndarray):
         """One step of the representatives of ``keys`` (all of one parity)."""
-        p, foff, voff = self.patches(keys)
+        p, _, voff = self.patches(keys)
         lvl = p.level
         plan = plan_step(lvl, p.corner, self.scheme, 2 - self.parity[keys[0]], self.loop_weights)
         S = step_matrix(lvl, plan)
@@ -206,8 +215,8 @@ class PatchTable:
             return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
 
         cid, ccorn = _candidates(p, offsets, shapes_of)
-        return dict(keys=keys, p=p, voff=voff, plan=plan, S=S.tocsr(), faces1=faces1, child=child, shapes_of=shapes_of,
-                    cid=cid, ccorn=ccorn)
+        return {"keys": keys, "p": p, "voff": voff, "plan": plan, "S": S.tocsr(), "faces1": faces1, "child": child,
+                "shapes_of": shapes_of, "cid": cid, "ccorn": ccorn}
 
     def _refined(self, keys: np.ndarray):
         """:meth:`_refine` per parity; the last result is kept for :meth:`fill_children`."""
@@ -279,7 +288,7 @@ class PatchTable:
     def fill_stencils(self, keys: np.ndarray):
         """The last interpolation's data of ``keys`` (unique, none yet): stencil vertices, their
         limit rows over the patch, the stencil matrix."""
-        p, foff, voff = self.patches(keys)
+        p, _, voff = self.patches(keys)
         ids, A, full, c0, scale, here = stencil_nodes(p)
         needed = np.unique(ids[ids >= 0])
         L = limit_rows(p, needed, self.scheme, self.loop_weights, self.tol, self.max_levels)

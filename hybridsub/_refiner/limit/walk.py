@@ -131,7 +131,8 @@ def fill_polynomials(table: PatchTable, keys: np.ndarray):
 
 def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
     """Rows over the control vertices of the points (face ``f``, bary ``b``): value, then
-    ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR matrix)."""
+    ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR
+    matrix)."""
     q = len(f)
     keys0 = starts.of(f)
     uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
