@@ -150,3 +150,17 @@ def test_quartic_kernel_matches_its_definition():
     for o, (r1, r2) in enumerate(((0, 0), (0, 1), (1, 1))):
         assert np.allclose(W[:, 3 + o], Huv[:, :, r1, r2], rtol=1e-12, atol=1e-10)
     assert np.allclose(B[0].sum(axis=1), 1.0)  # a partition of unity
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid", "sqrt3"])
+def test_patches_joined_at_a_vertex_only(scheme):
+    """A bowtie (two fans sharing one vertex): the canonical order reaches the second fan
+    through no edge, and the cached walk still equals the direct descent."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.2], [0, 1, 0.1], [-1, 0, 0.3], [-1, -1, 0], [0, -1, 0.1]])
+    F = np.array([[0, 1, 2], [0, 2, 3], [0, 4, 5], [0, 5, 6]])
+    s = hybridsub.LimitSurface(V, F, scheme=scheme, depth=6)
+    s._table.regular_stop = False
+    face, bary = _points(F, 40, seed=9)
+    f, b = s._points(face, bary)
+    direct = direct_rows(s._inp, f, b, 1, s.depth, 1e-12, 60)[0]
+    assert np.abs(s.evaluation_matrix(face, bary) @ V - direct @ V).max() < 1e-13
