@@ -160,7 +160,7 @@ class LimitSurface:
             for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
                 acc.append(R)
         n = self._inp.n_vertices
-        mats = [sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
+        mats = [a[0] if len(a) == 1 else sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
         for M in mats:
             M.sum_duplicates()
             M.sort_indices()

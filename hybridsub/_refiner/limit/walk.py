@@ -30,6 +30,7 @@ class StartKeys:
         self.key = np.full(inp.n_faces, -1, np.int64)
         self.v0 = np.zeros(inp.n_faces, np.int64)
         self.vids = Grow((), np.int64)
+        self.order = Grow((), np.int64)  # per face: its canonical positions by increasing vertex id
 
     def of(self, faces: np.ndarray) -> np.ndarray:
         new = np.unique(faces[self.key[faces] < 0])
@@ -41,7 +42,10 @@ class StartKeys:
             ids, vperm, vstart = self.table.register(p.level, p.corner, p.shape, p.face, fstart,
                                                      int(inp.scheme == "sqrt3"))
             self.key[new] = ids
-            self.v0[new] = self.vids.append(sel.indices[vperm]) + vstart[:-1]
+            vids = sel.indices[vperm]
+            node_v = np.repeat(np.arange(len(new)), np.diff(vstart))
+            self.v0[new] = self.vids.append(vids) + vstart[:-1]
+            self.order.append(np.lexsort((vids, node_v)) - vstart[node_v])
         return self.key[faces]
 
 
@@ -137,15 +141,17 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     keys0 = starts.of(f)
     uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
     out = walk(table, keys0, b, uv, n_rows, depth, table.regular_stop)
-    # Onto the control vertices: each point's first patch in canonical order.
+    # Onto the control vertices: each point's first patch, by increasing vertex id.
     nv0 = table.nv.a[keys0]
-    live = np.arange(out.shape[1])[None, :] < nv0[:, None]
-    cols = starts.vids.a[(starts.v0[f][:, None] + np.arange(out.shape[1])[None, :])[live]]
+    row, k = np.nonzero(np.arange(out.shape[1])[None, :] < nv0[:, None])
+    base = starts.v0[f][row]
+    loc = starts.order.a[base + k]
+    cols = starts.vids.a[base + loc]
     indptr = np.concatenate([[0], np.cumsum(nv0)])
     n = starts.inp.n_vertices
     mats = []
     for r in range(n_rows):
-        M = sp.csr_matrix((out[:, :, r][live], cols, indptr), shape=(q, n))
-        M.sort_indices()
+        M = sp.csr_matrix((out[row, loc, r], cols, indptr), shape=(q, n))
+        M.has_canonical_format = True  # sorted, no duplicates: one patch's distinct vertices
         mats.append(M)
     return mats
