@@ -181,10 +181,22 @@ def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row
         for lev in range(d - 1, -1, -1):
             c = path[q, lev]
             nxt[:nv[keys[q, lev]]] = 0.0
-            for e in range(t_start[c], t_end[c]):
-                a, b, x = t_row[e], t_col[e], t_val[e]
+            e, end = t_start[c], t_end[c]
+            while e < end:  # entries by row: a row whose sums are all zero is skipped
+                a = t_row[e]
+                live = False
                 for r in range(nr):
-                    nxt[b, r] += cur[a, r] * x
+                    if cur[a, r] != 0.0:
+                        live = True
+                if live:
+                    while e < end and t_row[e] == a:
+                        b, x = t_col[e], t_val[e]
+                        for r in range(nr):
+                            nxt[b, r] += cur[a, r] * x
+                        e += 1
+                else:
+                    while e < end and t_row[e] == a:
+                        e += 1
             cur, nxt = nxt, cur
         m = nv[keys[q, 0]]
         out[q, :m] = cur[:m]
