@@ -165,41 +165,48 @@ def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row
         for lev in range(stop[q] + 1):
             nmax = max(nmax, nv[keys[q, lev]])
     nr = W.shape[1]
-    cur = np.empty((nmax, nr))
-    nxt = np.empty((nmax, nr))
+    buf = np.zeros((2, nmax, nr))  # this level's rows and the next's, by turns
     for q in range(len(stop)):
         d = stop[q]
+        s = 0
         n = nv[keys[q, d]]
-        cur[:n] = 0.0
+        for v in range(n):
+            for r in range(nr):
+                buf[0, v, r] = 0.0
         for j in range(slots[q]):
             base = block[q] + j * n
             for v in range(n):
                 x = st_L[base + v]
-                if x != 0.0:
-                    for r in range(nr):
-                        cur[v, r] += W[q, r, j] * x
+                for r in range(nr):
+                    buf[0, v, r] += W[q, r, j] * x
         for lev in range(d - 1, -1, -1):
             c = path[q, lev]
-            nxt[:nv[keys[q, lev]]] = 0.0
-            e, end = t_start[c], t_end[c]
-            while e < end:  # entries by row: a row whose sums are all zero is skipped
+            t = 1 - s
+            for v in range(nv[keys[q, lev]]):
+                for r in range(nr):
+                    buf[t, v, r] = 0.0
+            e = t_start[c]
+            end = t_end[c]
+            while e < end:  # entries by row: rows whose sums are all zero are skipped
                 a = t_row[e]
                 live = False
                 for r in range(nr):
-                    if cur[a, r] != 0.0:
+                    if buf[s, a, r] != 0.0:
                         live = True
                 if live:
                     while e < end and t_row[e] == a:
-                        b, x = t_col[e], t_val[e]
+                        x = t_val[e]
+                        b = t_col[e]
                         for r in range(nr):
-                            nxt[b, r] += cur[a, r] * x
+                            buf[t, b, r] += buf[s, a, r] * x
                         e += 1
                 else:
                     while e < end and t_row[e] == a:
                         e += 1
-            cur, nxt = nxt, cur
-        m = nv[keys[q, 0]]
-        out[q, :m] = cur[:m]
+            s = t
+        for v in range(nv[keys[q, 0]]):
+            for r in range(nr):
+                out[q, v, r] = buf[s, v, r]
 
 
 @kernel
