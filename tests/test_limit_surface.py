@@ -150,6 +150,21 @@ def test_project_returns_points_pushed_off_along_the_normal():
     assert np.abs(s.evaluate(f2, b2) - Q).max() < 1e-12 * diag
 
 
+@pytest.mark.parametrize("case", ["sqrt3-closed", "hybrid-crease"])
+def test_points_of_the_surface_near_its_vertices_project_onto_themselves(case):
+    """The nearest seed of a point near an extraordinary vertex is that vertex, where Newton's
+    method stalls: the best of the point's seeds must be the one that goes on."""
+    V, F, kw = CASES[case]
+    s = hybridsub.LimitSurface(V, F, depth=12, **kw)
+    rng = np.random.default_rng(5)
+    face = rng.integers(0, len(F), 24)
+    bary = rng.dirichlet([1, 1, 1], 24) * 0.2
+    bary[np.arange(24), rng.integers(0, 3, 24)] += 0.8          # within a fifth of a corner
+    P = s.evaluate(face, bary)
+    _, _, Q, dist = s.project(P)
+    assert np.abs(dist).max() < 1e-9 * _diag(V) and np.abs(Q - P).max() < 1e-9 * _diag(V)
+
+
 def test_bad_points_are_named():
     s = hybridsub.LimitSurface(OCTA_V, OCTA_F, depth=2)
     with pytest.raises(ValueError, match=r"face\[1\] = 8 is not a face"):

@@ -129,7 +129,7 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     face, bary = _iterate(surface, X, many, sf[near].copy(), sb[near].copy(), min(COARSE_DEPTH, surface.depth),
                           max_iter, COARSE_STEP)
     # The best of each point's seeds goes on at the full depth.
-    d = np.linalg.norm(many - surface._matrix(face, bary, False, min(COARSE_DEPTH, surface.depth))[0] @ X, axis=1)
+    d = np.linalg.norm(many - surface._matrix(face, bary, False, min(COARSE_DEPTH, surface.depth)) @ X, axis=1)
     pick = np.arange(len(pts)) * k + np.argmin(d.reshape(len(pts), k), axis=1)
     face, bary = _iterate(surface, X, pts, face[pick], bary[pick], surface.depth, min(max_iter, FINE_ITER),
                           FINE_STEP)
