@@ -70,18 +70,7 @@ def closest_among(points, P, faces, candidates, face_out, bary_out, d2_out):
             f = candidates[i, j]
             if f < 0:
                 break
-            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-            u, v, w = _closest_on_triangle(px, py, pz, P, a, b, c)
-            qx = u * P[a, 0] + v * P[b, 0] + w * P[c, 0]
-            qy = u * P[a, 1] + v * P[b, 1] + w * P[c, 1]
-            qz = u * P[a, 2] + v * P[b, 2] + w * P[c, 2]
-            d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
-            if best < 0 or d < bd:
-                best = f
-                bd = d
-                bary_out[i, 0] = u
-                bary_out[i, 1] = v
-                bary_out[i, 2] = w
+            best, bd = _try_face(px, py, pz, P, faces, f, best, bd, bary_out[i])
         face_out[i] = best
         d2_out[i] = bd
 
@@ -147,6 +136,8 @@ def bin_faces(P, faces, lo, h, dims, start):
 
 @kernel(inline="always")
 def _try_face(px, py, pz, P, faces, f, best, bd, bary):
+    """Face ``f`` tried for point p: ``(f, its squared distance)`` with ``bary`` (3,) set when
+    it is nearer than ``bd`` (or no face was found yet), else ``(best, bd)`` unchanged."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
     u, v, w = _closest_on_triangle(px, py, pz, P, a, b, c)
     qx = u * P[a, 0] + v * P[b, 0] + w * P[c, 0]

@@ -207,7 +207,7 @@ class LevelSurface:
     def system(self, feet: Feet, weight: float, lam: float):
         """``H`` and ``g`` on the control points: the data term summed per face of the level
         (a kernel), assembled on the level's vertices, then ``diag(S,S,S)ᵀ H diag(S,S,S)``."""
-        m, nf, nl = len(feet.face), len(self.faces), self.S.shape[0]
+        nf, nl = len(self.faces), self.S.shape[0]
         Hf = np.zeros((nf, 3, 3, 3, 3))
         gf = np.zeros((nf, 3, 3))
         face_systems(feet.face, feet.bary, point_metric(feet.normals, weight, lam), feet.residual, Hf, gf)

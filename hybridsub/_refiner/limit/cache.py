@@ -28,15 +28,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._topology import Level, child_level, face_parents, plan_step
-from ..chart import barycentric, child_shapes, plan_supports
-from ..stencils import step_matrix
+from ..._topology import Level
+from ..chart import barycentric
 from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
 from .descent import (
     Patches,
-    _candidates,
     cut_patches,
     limit_rows,
+    refine_patches,
     ring_faces,
     stencil_nodes,
 )
@@ -204,17 +203,8 @@ class PatchTable:
     def _refine(self, keys: np.ndarray):
         """One step of the representatives of ``keys`` (all of one parity)."""
         p, _, voff = self.patches(keys)
-        lvl = p.level
-        plan = plan_step(lvl, p.corner, self.scheme, 2 - self.parity[keys[0]], self.loop_weights)
-        S = step_matrix(lvl, plan)
-        faces1, child, offsets = child_level(lvl, plan)
-        ids, w = plan_supports(lvl.faces, plan, lvl.n_vertices)
-        parent = face_parents(offsets)
-
-        def shapes_of(faces):
-            return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
-
-        cid, ccorn = _candidates(p, offsets, shapes_of)
+        plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, self.scheme, 2 - self.parity[keys[0]],
+                                                                       self.loop_weights)
         return {"keys": keys, "p": p, "voff": voff, "plan": plan, "S": S.tocsr(), "faces1": faces1, "child": child,
                 "shapes_of": shapes_of, "cid": cid, "ccorn": ccorn}
 

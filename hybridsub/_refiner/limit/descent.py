@@ -101,9 +101,11 @@ def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
     return ids.reshape(k, -1), corners.reshape(k, -1, 3, 2)
 
 
-def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weights: str, step_no: int):
-    """One level down: refine the patches, follow every point into its child face, cut the
-    next patches. Returns (next Patches, map from this level's vertices, qnode, bary)."""
+def refine_patches(p: Patches, scheme: str, step_no: int, loop_weights: str):
+    """One step of the patches ``p``: ``(plan, S, faces1, child, shapes_of, cid, ccorn)`` —
+    the step's plan and matrix, the next level's faces and :class:`Level`, ``shapes_of(faces)``
+    the child faces' corners in their parents' frames, and each node's candidate children
+    (:func:`_candidates`)."""
     lvl = p.level
     plan = plan_step(lvl, p.corner, scheme, step_no, loop_weights)
     S = step_matrix(lvl, plan)
@@ -115,6 +117,14 @@ def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weig
         return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
 
     cid, ccorn = _candidates(p, offsets, shapes_of)
+    return plan, S, faces1, child, shapes_of, cid, ccorn
+
+
+def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weights: str, step_no: int):
+    """One level down: refine the patches, follow every point into its child face, cut the
+    next patches. Returns (next Patches, map from this level's vertices, qnode, bary)."""
+    lvl = p.level
+    plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, scheme, step_no, loop_weights)
     x = np.einsum("qc,qcd->qd", bary, p.shape[p.face[qnode]])
     b = barycentric(ccorn[qnode], x[:, None, :])  # (q, 24, 3)
     score = np.where(cid[qnode] >= 0, b.min(axis=2), -np.inf)
