@@ -151,6 +151,50 @@ def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv
                 uv_out[q, i, d] = G[i, 0] * uv[q, 0, d] + G[i, 1] * uv[q, 1, d] + G[i, 2] * uv[q, 2, d]
 
 
+@kernel(inline="always")
+def _back_any(buf, s, t, e, end, t_row, t_col, t_val):
+    """``buf[t] += T^T buf[s]`` over the entries ``e:end`` of one transition, by rows: rows
+    whose sums are all zero are skipped."""
+    nr = buf.shape[2]
+    while e < end:
+        a = t_row[e]
+        live = False
+        for r in range(nr):
+            if buf[s, a, r] != 0.0:
+                live = True
+        if live:
+            while e < end and t_row[e] == a:
+                x = t_val[e]
+                b = t_col[e]
+                for r in range(nr):
+                    buf[t, b, r] += buf[s, a, r] * x
+                e += 1
+        else:
+            while e < end and t_row[e] == a:
+                e += 1
+
+
+@kernel(inline="always")
+def _back3(buf, s, t, e, end, t_row, t_col, t_val):
+    """:func:`_back_any` for three rows (value, ∂/∂u, ∂/∂v) held in registers: the same sums."""
+    while e < end:
+        a = t_row[e]
+        r0 = buf[s, a, 0]
+        r1 = buf[s, a, 1]
+        r2 = buf[s, a, 2]
+        if r0 != 0.0 or r1 != 0.0 or r2 != 0.0:
+            while e < end and t_row[e] == a:
+                x = t_val[e]
+                b = t_col[e]
+                buf[t, b, 0] += r0 * x
+                buf[t, b, 1] += r1 * x
+                buf[t, b, 2] += r2 * x
+                e += 1
+        else:
+            while e < end and t_row[e] == a:
+                e += 1
+
+
 @kernel
 def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row, t_col, t_val, out):
     """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
@@ -187,22 +231,10 @@ def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row
                     buf[t, v, r] = 0.0
             e = t_start[c]
             end = t_end[c]
-            while e < end:  # entries by row: rows whose sums are all zero are skipped
-                a = t_row[e]
-                live = False
-                for r in range(nr):
-                    if buf[s, a, r] != 0.0:
-                        live = True
-                if live:
-                    while e < end and t_row[e] == a:
-                        x = t_val[e]
-                        b = t_col[e]
-                        for r in range(nr):
-                            buf[t, b, r] += buf[s, a, r] * x
-                        e += 1
-                else:
-                    while e < end and t_row[e] == a:
-                        e += 1
+            if nr == 3:
+                _back3(buf, s, t, e, end, t_row, t_col, t_val)
+            else:
+                _back_any(buf, s, t, e, end, t_row, t_col, t_val)
             s = t
         for v in range(nv[keys[q, 0]]):
             for r in range(nr):
