@@ -52,10 +52,9 @@ class StartKeys:
 def _pick(table: PatchTable, key, bary, uv):
     """One level for every point: the candidate chosen, the point's barycentric coordinates
     in it and its corners in (u, v); keys met for the first time are refined first."""
-    uk = np.unique(key)
-    lack = uk[table.cand_start.a[uk] < 0]
+    lack = key[table.cand_start.a[key] < 0]
     if len(lack):
-        table.fill_steps(lack)
+        table.fill_steps(np.unique(lack))
     chosen = np.empty(len(key), np.int64)
     nb, nuv = np.empty_like(bary), np.empty_like(uv)
     pick_children(key, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a, chosen, nb, nuv)
