@@ -8,6 +8,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import kernel
+from ..._topology import group_by_origin
+
+
+@kernel(inline="always")
+def _push(arr, n, x):
+    """``arr`` with ``x`` at ``n`` (doubled when full)."""
+    if n == len(arr):
+        arr = np.concatenate((arr, np.empty(max(n, 1), np.int64)))
+    arr[n] = x
+    return arr
 
 
 @kernel
@@ -15,24 +25,11 @@ def ring_pairs(F, n, centre, rings):
     """(node, face) pairs, sorted: the faces within ``rings`` vertex rings of each node's
     centre face, over a mesh ``F`` of ``n`` vertices."""
     m = len(F)
-    ptr = np.zeros(n + 1, np.int64)
-    for f in range(m):
-        for c in range(3):
-            ptr[F[f, c] + 1] += 1
-    for v in range(n):
-        ptr[v + 1] += ptr[v]
-    fill = ptr[:-1].copy()
-    faces_of = np.empty(3 * m, np.int64)
-    for f in range(m):
-        for c in range(3):
-            v = F[f, c]
-            faces_of[fill[v]] = f
-            fill[v] += 1
+    by_origin, ptr = group_by_origin(F, n)  # a vertex's faces: its outgoing halfedges' faces
     vmark = np.full(n, -1, np.int64)
     fmark = np.full(m, -1, np.int64)
-    cap = max(16, 32 * len(centre))
-    out_n = np.empty(cap, np.int64)
-    out_f = np.empty(cap, np.int64)
+    out_n = np.empty(max(16, 32 * len(centre)), np.int64)
+    out_f = np.empty(len(out_n), np.int64)
     size = 0
     verts = np.empty(16, np.int64)
     faces = np.empty(16, np.int64)
@@ -42,9 +39,7 @@ def ring_pairs(F, n, centre, rings):
             v = F[centre[i], c]
             if vmark[v] != i:
                 vmark[v] = i
-                if nv == len(verts):
-                    verts = np.concatenate((verts, np.empty(nv, np.int64)))
-                verts[nv] = v
+                verts = _push(verts, nv, v)
                 nv += 1
         nf = 0
         lo = 0
@@ -53,36 +48,29 @@ def ring_pairs(F, n, centre, rings):
             for a in range(lo, hi):
                 v = verts[a]
                 for k in range(ptr[v], ptr[v + 1]):
-                    f = faces_of[k]
+                    f = by_origin[k] // 3
                     if fmark[f] == i:
                         continue
                     fmark[f] = i
-                    if nf == len(faces):
-                        faces = np.concatenate((faces, np.empty(nf, np.int64)))
-                    faces[nf] = f
+                    faces = _push(faces, nf, f)
                     nf += 1
                     if r < rings - 1:
                         for c in range(3):
                             w = F[f, c]
                             if vmark[w] != i:
                                 vmark[w] = i
-                                if nv == len(verts):
-                                    verts = np.concatenate((verts, np.empty(nv, np.int64)))
-                                verts[nv] = w
+                                verts = _push(verts, nv, w)
                                 nv += 1
             lo = hi
-        if size + nf > cap:
-            cap = 2 * (size + nf)
-            out_n = np.concatenate((out_n[:size], np.empty(cap - size, np.int64)))
-            out_f = np.concatenate((out_f[:size], np.empty(cap - size, np.int64)))
         for a in range(nf):  # insertion sort: a few dozen faces
             x = faces[a]
+            out_n = _push(out_n, size + a, i)
+            out_f = _push(out_f, size + a, x)
             b = size + a
             while b > size and out_f[b - 1] > x:
                 out_f[b] = out_f[b - 1]
                 b -= 1
             out_f[b] = x
-            out_n[size + a] = i
         size += nf
     return out_n[:size], out_f[:size]
 
