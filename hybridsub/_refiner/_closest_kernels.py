@@ -166,6 +166,15 @@ def _gap(x, c0, h):
     return 0.0
 
 
+@kernel(inline="always")
+def _home(x, lo, h, dim):
+    """The cell index along one axis of coordinate ``x`` clamped into the grid, and the
+    clamped coordinate's distance to that cell's nearer wall."""
+    c = min(max(x, lo), lo + dim * h)
+    i = min(max(int((c - lo) / h), 0), dim - 1)
+    return i, min(c - (lo + i * h), lo + (i + 1) * h - c)
+
+
 @kernel(parallel=True)
 def closest_in_grid(points, P, faces, lo, h, dims, start, cell_faces, face_out, bary_out, d2_out):
     """The closest point of each point on the mesh, exactly, through the grid of :func:`bin_faces`.
@@ -184,34 +193,30 @@ def closest_in_grid(points, P, faces, lo, h, dims, start, cell_faces, face_out, 
         best, bd = -1, np.inf
         if face_out[i] >= 0:
             best, bd = _try_face(px, py, pz, P, faces, face_out[i], best, bd, bary)
-        cell = np.empty(3, np.int64)
-        delta = np.inf
-        for a in range(3):
-            c = min(max(points[i, a], lo[a]), lo[a] + dims[a] * h)
-            ci = min(max(int((c - lo[a]) / h), 0), dims[a] - 1)
-            cell[a] = ci
-            delta = min(delta, c - (lo[a] + ci * h), lo[a] + (ci + 1) * h - c)
-        delta = max(delta, 0.0)
+        ci, wx = _home(px, lo[0], h, dims[0])
+        cj, wy = _home(py, lo[1], h, dims[1])
+        ck, wz = _home(pz, lo[2], h, dims[2])
+        delta = max(min(wx, min(wy, wz)), 0.0)
         for r in range(nmax + 1):
             if r > 0:
                 lb = (r - 1) * h + delta
                 if lb * lb >= bd:
                     break
             for di in range(-r, r + 1):
-                ii = cell[0] + di
+                ii = ci + di
                 if ii < 0 or ii >= dims[0]:
                     continue
                 for dj in range(-r, r + 1):
-                    jj = cell[1] + dj
+                    jj = cj + dj
                     if jj < 0 or jj >= dims[1]:
                         continue
                     inner = abs(di) < r and abs(dj) < r
                     dk = -r
                     while dk <= r:
-                        kk = cell[2] + dk
+                        kk = ck + dk
                         if 0 <= kk < dims[2] and _cell_d2(px, py, pz, lo, h, ii, jj, kk) < bd:
-                            c = (ii * dims[1] + jj) * dims[2] + kk
-                            for t in range(start[c], start[c + 1]):
+                            cell = (ii * dims[1] + jj) * dims[2] + kk
+                            for t in range(start[cell], start[cell + 1]):
                                 best, bd = _try_face(px, py, pz, P, faces, cell_faces[t], best, bd, bary)
                         dk += 2 * r if inner and r > 0 else 1
         face_out[i] = best

@@ -62,11 +62,12 @@ class ClosestPoints:
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
         self.queries = np.ascontiguousarray(queries, dtype=np.float64)
         self.previous = np.full(len(self.queries), -1, dtype=np.int64)
+        self.used = np.unique(self.faces)  # the vertices the grid must hold
 
     def search(self, P: np.ndarray) -> Footpoints:
         P = np.ascontiguousarray(P, dtype=np.float64)
         faces, m = self.faces, len(self.queries)
-        lo, h, dims = _grid(P, faces)
+        lo, h, dims = _grid(P[self.used], P[faces])
         start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
         cell_faces = bin_faces(P, faces, lo, h, dims, start)
         face = self.previous.copy()
@@ -78,16 +79,15 @@ class ClosestPoints:
         return Footpoints(face, bary, Q, np.sqrt(d2))
 
 
-def _grid(P: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
-    """Corner, cell size and cells per axis of the grid over the vertices the faces use."""
-    used = P[np.unique(faces)]
+def _grid(used: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
+    """Corner, cell size and cells per axis of the grid over the vertices ``used`` (k, 3) of
+    the triangles ``tri`` (f, 3, 3)."""
     lo, hi = used.min(axis=0), used.max(axis=0)
-    tri = P[faces]
     edge = float(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).mean())
     extent = np.maximum(hi - lo, 0.0)
     h = max(_CELL_EDGES * edge, float(extent.max()) * 1e-9, 1e-300)
     while True:
         dims = np.maximum(np.ceil(extent / h).astype(np.int64), 1)
-        if int(np.prod(dims)) <= max(_CELLS_PER_FACE * len(faces), 64):
+        if int(np.prod(dims)) <= max(_CELLS_PER_FACE * len(tri), 64):
             return lo, h, dims
         h *= 1.5
