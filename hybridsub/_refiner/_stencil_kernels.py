@@ -32,66 +32,6 @@ def _neighbour_coefficient(v, s, coef):
     return c
 
 
-@kernel(inline="always")
-def _scale_row(out, r, c, X, v, k):
-    """``out[r] = c X[v]`` (three columns spelled out: the common case runs unrolled)."""
-    if k == 3:
-        out[r, 0] = c * X[v, 0]
-        out[r, 1] = c * X[v, 1]
-        out[r, 2] = c * X[v, 2]
-    else:
-        for j in range(k):
-            out[r, j] = c * X[v, j]
-
-
-@kernel(inline="always")
-def _add_scaled_row(out, r, c, X, v, k):
-    """``out[r] += c X[v]``, as :func:`_scale_row`."""
-    if k == 3:
-        out[r, 0] += c * X[v, 0]
-        out[r, 1] += c * X[v, 1]
-        out[r, 2] += c * X[v, 2]
-    else:
-        for j in range(k):
-            out[r, j] += c * X[v, j]
-
-
-@kernel(inline="always")
-def _combine2(out, r, c, X, a, b, k):
-    """``out[r] = c X[a] + c X[b]``."""
-    if k == 3:
-        out[r, 0] = c * X[a, 0] + c * X[b, 0]
-        out[r, 1] = c * X[a, 1] + c * X[b, 1]
-        out[r, 2] = c * X[a, 2] + c * X[b, 2]
-    else:
-        for j in range(k):
-            out[r, j] = c * X[a, j] + c * X[b, j]
-
-
-@kernel(inline="always")
-def _combine3(out, r, c0, c1, c2, X, a, b, d, k):
-    """``out[r] = c0 X[a] + c1 X[b] + c2 X[d]``."""
-    if k == 3:
-        out[r, 0] = c0 * X[a, 0] + c1 * X[b, 0] + c2 * X[d, 0]
-        out[r, 1] = c0 * X[a, 1] + c1 * X[b, 1] + c2 * X[d, 1]
-        out[r, 2] = c0 * X[a, 2] + c1 * X[b, 2] + c2 * X[d, 2]
-    else:
-        for j in range(k):
-            out[r, j] = c0 * X[a, j] + c1 * X[b, j] + c2 * X[d, j]
-
-
-@kernel(inline="always")
-def _combine4(out, r, cab, ccd, X, a, b, c, d, k):
-    """``out[r] = cab X[a] + cab X[b] + ccd X[c] + ccd X[d]`` (Loop's edge point)."""
-    if k == 3:
-        out[r, 0] = cab * X[a, 0] + cab * X[b, 0] + ccd * X[c, 0] + ccd * X[d, 0]
-        out[r, 1] = cab * X[a, 1] + cab * X[b, 1] + ccd * X[c, 1] + ccd * X[d, 1]
-        out[r, 2] = cab * X[a, 2] + cab * X[b, 2] + ccd * X[c, 2] + ccd * X[d, 2]
-    else:
-        for j in range(k):
-            out[r, j] = cab * X[a, j] + cab * X[b, j] + ccd * X[c, j] + ccd * X[d, j]
-
-
 def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks):
     """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
 
@@ -107,7 +47,8 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
         lo = c * n // chunks
         hi = (c + 1) * n // chunks
         for v in range(lo, hi):
-            _scale_row(out, v, coef[0, v], X, v, k)
+            for j in range(k):
+                out[v, j] = coef[0, v] * X[v, j]
         for h in range(3 * m):
             t = twin[h]
             if t >= 0 and t < h:
@@ -122,11 +63,13 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
             if mine_u:
                 cu = _neighbour_coefficient(u, s, coef)
                 if cu != 0.0:
-                    _add_scaled_row(out, u, cu, X, w, k)
+                    for j in range(k):
+                        out[u, j] += cu * X[w, j]
             if mine_w:
                 cw = _neighbour_coefficient(w, s, coef)
                 if cw != 0.0:
-                    _add_scaled_row(out, w, cw, X, u, k)
+                    for j in range(k):
+                        out[w, j] += cw * X[u, j]
     for h in prange(3 * m):
         r = edge_point[h]
         t = twin[h]
@@ -137,18 +80,27 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
         if hkind[h] == EDGE_TRISECT:
             p0 = origin(F, bprev[h])
             p3 = dest(F, bnext[h])
-            _combine3(out, r, _T0, _T1, _T2, X, p0, u, w, k)
-            _combine3(out, r + 1, _T2, _T1, _T0, X, u, w, p3, k)
+            for j in range(k):
+                out[r, j] = _T0 * X[p0, j] + _T1 * X[u, j] + _T2 * X[w, j]
+                out[r + 1, j] = _T2 * X[u, j] + _T1 * X[w, j] + _T0 * X[p3, j]
             continue
         wab, wcd = edge_weights(edge_sharpness(h, twin, hsharp, has_tags))
         if wcd == 0.0:
-            _combine2(out, r, wab, X, u, w, k)
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j]
         else:
-            _combine4(out, r, wab, wcd, X, u, w, opposite(F, h), opposite(F, t), k)
+            a = opposite(F, h)
+            b = opposite(F, t)
+            for j in range(k):
+                out[r, j] = wab * X[u, j] + wab * X[w, j] + wcd * X[a, j] + wcd * X[b, j]
     for f in prange(m):
         r = face_point[f]
         if r >= 0:
-            _combine3(out, r, _THIRD, _THIRD, _THIRD, X, F[f, 0], F[f, 1], F[f, 2], k)
+            a = F[f, 0]
+            b = F[f, 1]
+            c3 = F[f, 2]
+            for j in range(k):
+                out[r, j] = _THIRD * X[a, j] + _THIRD * X[b, j] + _THIRD * X[c3, j]
 
 
 apply_step, apply_step_serial = threaded_and_serial(_apply_step)
