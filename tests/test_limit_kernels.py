@@ -37,7 +37,7 @@ def _descent(name, levels=3, points=12):
     rng = np.random.default_rng(1)
     f = np.sort(rng.integers(0, len(F), points))
     faces0, qn = np.unique(f, return_inverse=True)
-    p, _ = D.start(inp, faces0)
+    p, _, _ = D.start(inp, faces0)
     qn, b = qn.ravel(), rng.dirichlet([1, 1, 1], points)
     out = []
     for k in range(levels):

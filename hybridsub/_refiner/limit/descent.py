@@ -71,14 +71,15 @@ def cut_patches(level: Level, corner: np.ndarray, node: np.ndarray, f: np.ndarra
 
 
 def start(inp: RefineInput, faces0: np.ndarray):
-    """Level-0 patches around the input faces ``faces0`` (one node each) and their selection."""
+    """Level-0 patches around the input faces ``faces0`` (one node each), their selection
+    (CSR, patch vertices × input vertices) and where each node's faces start (k + 1,)."""
     node, f = ring_faces(inp.level.faces, inp.n_vertices, faces0)
     level, corner, vsel, fkeys = cut_patches(inp.level, inp.corner, node, f)
     sel = sp.csr_matrix((np.ones(len(vsel)), vsel, np.arange(len(vsel) + 1)), shape=(len(vsel), inp.n_vertices))
     cur = np.searchsorted(fkeys, np.arange(len(faces0)) * inp.n_faces + faces0)
     shape = np.repeat(EQUILATERAL[None], level.n_faces, axis=0)
     uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(faces0), axis=0)
-    return Patches(level, corner, shape, cur, uv), sel
+    return Patches(level, corner, shape, cur, uv), sel, np.searchsorted(node, np.arange(len(faces0) + 1))
 
 
 def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
@@ -249,7 +250,7 @@ def direct_rows(inp: RefineInput, f: np.ndarray, b: np.ndarray, n_rows: int, dep
     """The rows of :func:`.walk.walk_rows` by the direct descent, every patch refined where it
     is met (no cache): the reference the cached walk is tested against."""
     faces0, qn = np.unique(f, return_inverse=True)
-    p, sel0 = start(inp, faces0)
+    p, sel0, _ = start(inp, faces0)
     maps = [sel0]
     qn, bb = qn.ravel(), b
     for k in range(depth):

@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from ..._input import RefineInput
 from ._cache_kernels import back_rows, pick_children, stencil_points
 from .cache import Grow, PatchTable
-from .descent import ring_faces, start
+from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights
 
 
@@ -36,9 +36,7 @@ class StartKeys:
         new = np.unique(faces[self.key[faces] < 0])
         if len(new):
             inp = self.inp
-            p, sel = start(inp, new)
-            node, _ = ring_faces(inp.level.faces, inp.n_vertices, new)
-            fstart = np.searchsorted(node, np.arange(len(new) + 1))
+            p, sel, fstart = start(inp, new)
             ids, vperm, vstart = self.table.register(p.level, p.corner, p.shape, p.face, fstart,
                                                      int(inp.scheme == "sqrt3"))
             self.key[new] = ids
