@@ -33,10 +33,9 @@ from ..chart import barycentric
 from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
 from .descent import (
     Patches,
-    cut_patches,
+    cut_children,
     limit_rows,
     refine_patches,
-    ring_faces,
     stencil_nodes,
 )
 
@@ -250,16 +249,9 @@ class PatchTable:
 
     def _cut_children(self, r, cands, owners):
         node = np.searchsorted(r["keys"], owners) if _sorted(r["keys"]) else _position(r["keys"], owners)
-        faces1, p = r["faces1"], r["p"]
         centre = r["cid"][node, self.slot.a[cands]]
-        n_new = r["plan"].n_new
-        corner1 = np.concatenate([p.corner, np.zeros(n_new - p.level.n_vertices, bool)])
-        nd, f = ring_faces(faces1, n_new, centre)
-        nxt, corner_n, vsel, fkeys = cut_patches(r["child"], corner1, nd, f)
-        cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
-        used, back = np.unique(f, return_inverse=True)
-        shape_n = r["shapes_of"](used)[back]
-        fstart = np.searchsorted(nd, np.arange(len(centre) + 1))
+        nxt, corner_n, shape_n, cur, vsel, fstart = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
+                                                                 r["shapes_of"], centre)
         parity = self.parity[owners[0]] ^ 1 if self.scheme == "sqrt3" else 0
         kids, vperm, vstart = self.register(nxt, corner_n, shape_n, cur, fstart, parity)
         T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order

@@ -124,7 +124,6 @@ def refine_patches(p: Patches, scheme: str, step_no: int, loop_weights: str):
 def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weights: str, step_no: int):
     """One level down: refine the patches, follow every point into its child face, cut the
     next patches. Returns (next Patches, map from this level's vertices, qnode, bary)."""
-    lvl = p.level
     plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, scheme, step_no, loop_weights)
     x = np.einsum("qc,qcd->qd", bary, p.shape[p.face[qnode]])
     b = barycentric(ccorn[qnode], x[:, None, :])  # (q, 24, 3)
@@ -138,13 +137,21 @@ def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weig
     own = ccorn[qnode[first], pick[first]]  # (k', 3, 2) the chosen faces' corners, parent node frame
     lam = barycentric(p.shape[p.face[qnode[first]]][:, None], own)
     uv = lam @ p.uv[qnode[first]]
-    corner1 = np.concatenate([p.corner, np.zeros(plan.n_new - lvl.n_vertices, bool)])
+    nxt, corner_n, shape_n, cur, vsel, _ = cut_children(p, plan, faces1, child, shapes_of, centre)
+    return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(S)[vsel], qn.ravel(), nb
+
+
+def cut_children(p: Patches, plan, faces1: np.ndarray, child: Level, shapes_of, centre: np.ndarray):
+    """The patches (two rings) round the child faces ``centre`` of :func:`refine_patches`'
+    step, as a new mesh of disjoint pieces: its :class:`Level`, corner mask, face shapes, each
+    piece's centre face, the refined vertex of each new vertex, where each piece's faces start."""
+    corner1 = np.concatenate([p.corner, np.zeros(plan.n_new - p.level.n_vertices, bool)])
     node, f = ring_faces(faces1, plan.n_new, centre)
     nxt, corner_n, vsel, fkeys = cut_patches(child, corner1, node, f)
     cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
     used, back = np.unique(f, return_inverse=True)
-    shape_n = shapes_of(used)[back]
-    return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(S)[vsel], qn.ravel(), nb
+    fstart = np.searchsorted(node, np.arange(len(centre) + 1))
+    return nxt, corner_n, shapes_of(used)[back], cur, vsel, fstart
 
 
 def _edge_tags(level: Level, scheme: str):
