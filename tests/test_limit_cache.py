@@ -103,32 +103,65 @@ def _torus(n=6, seed=6):
     return V, np.array(F)
 
 
-@pytest.mark.parametrize("mesh", ["torus", "octahedron"])
+def _grid(n=6, seed=9):
+    """An open n × n grid of triangles, jittered: boundary vertices with three faces (regular
+    on the boundary) along the sides, two or one at the corners."""
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    V = np.stack([i.ravel() + 0.5 * j.ravel(), j.ravel() * 0.87, np.zeros(i.size)], 1)
+    V += 0.05 * np.random.default_rng(seed).standard_normal(V.shape)
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    F = [[idx[x, y], idx[x + 1, y], idx[x, y + 1]] for x in range(n) for y in range(n)]
+    F += [[idx[x + 1, y], idx[x + 1, y + 1], idx[x, y + 1]] for x in range(n) for y in range(n)]
+    return V, np.array(F)
+
+
+def _regular_meshes(mesh):
+    if mesh == "torus":
+        return _torus(), {"scheme": "loop"}
+    if mesh == "torus-crease":  # straight creases round the tube and along a diagonal (crossing
+        V, F = _torus()  # at a corner), and a kinked one
+        return (V, F), {"scheme": "loop", "sharp_edges": [[x * 6, ((x + 1) % 6) * 6] for x in range(6)]
+                        + [[x * 7, (x + 1) % 6 * 7] for x in range(6)] + [[3, 9], [9, 10], [10, 16]]}
+    if mesh == "grid-boundary":
+        return _grid(), {"scheme": "loop"}
+    if mesh == "torus-hybrid":  # Loop faces round a straight crease, √3 faces further off
+        (V, F), kw = _regular_meshes("torus-crease")
+        near = np.isin(F, np.arange(0, 36, 6)).any(axis=1) | np.isin(F, np.arange(1, 36, 6)).any(axis=1)
+        return (V, F), {"scheme": "hybrid", "sharp_edges": kw["sharp_edges"][:6], "sharp_faces": near}
+    return (OCTA_V, OCTA_F), {"scheme": "loop"}
+
+
+@pytest.mark.parametrize("mesh", ["torus", "torus-crease", "grid-boundary", "torus-hybrid", "octahedron"])
 def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
     """The walk stops at regular Loop patches (every point of the torus at once, those of the
-    octahedron once away from its valence-4 vertices) and takes the box spline there: the
-    same surface as the walk to full depth, derivatives closer to the truth (exact)."""
-    V, F = _torus() if mesh == "torus" else (OCTA_V, OCTA_F)
+    octahedron once away from its valence-4 vertices; beside straight creases and boundaries
+    too) and takes the box spline there: the same surface as the walk to full depth,
+    derivatives closer to the truth (exact)."""
+    (V, F), kw = _regular_meshes(mesh)
     face, bary = _points(F, 80, seed=7)
-    s = hybridsub.LimitSurface(V, F, scheme="loop")
+    s = hybridsub.LimitSurface(V, F, **kw)
     P, Du, Dv = s.evaluate(face, bary, derivatives=True)
-    deep = hybridsub.LimitSurface(V, F, scheme="loop", depth=20)
+    deep = hybridsub.LimitSurface(V, F, depth=24, **kw)
     deep._table.regular_stop = False
     Pd, Dud, Dvd = deep.evaluate(face, bary, derivatives=True)
     assert np.abs(P - Pd).max() < 1e-13 * np.abs(Pd).max()
     scale = np.abs(Dud).max()
     assert np.abs(Du - Dud).max() < 1e-6 * scale and np.abs(Dv - Dvd).max() < 1e-6 * scale
-    # Central differences of the quartic: its derivatives to the differences' own error.
+    # Central differences of the quartic: its derivatives to the differences' own error (in
+    # the hybrid's √3 faces the chart's (u, v) bends at the children's edges: not there).
     h = 1e-4
-    inside = (bary[:, 1:] > 2 * h).all(axis=1) & (bary[:, 0] > 2 * h)
+    inside = (bary[:, 1:] > 2 * h).all(axis=1) & (bary[:, 0] > 2 * h) & (kw["scheme"] == "loop")
     shift = np.array([-1.0, 1.0, 0.0]) * h
     fd = (s.evaluate(face[inside], bary[inside] + shift) - s.evaluate(face[inside], bary[inside] - shift)) / (2 * h)
-    assert np.abs(fd - Du[inside]).max() < 1e-6 * scale
+    assert np.abs(fd - Du[inside]).max(initial=0.0) < 1e-6 * scale
     t = s._table
     flags = [is_regular(F_, tw, hs, fs, c) for F_, tw, hs, fs, c, _ in t.reps]  # the kernel's definition
     assert np.array_equal(t.regular.a[:t.n_keys], np.array(flags, np.int8))
-    if mesh == "torus":
+    if mesh != "octahedron":
         assert t.regular.a[:t.n_keys].max() == 1 and (t.poly.a[:t.n_keys] >= 0).any()
+    if mesh in ("torus-crease", "grid-boundary", "torus-hybrid"):  # some regular keys: a crease at the centre
+        on_crease = [(r[1][:3] < 0).any() or (r[2] is not None and r[2][:3].any()) for r in t.reps]
+        assert (t.regular.a[:t.n_keys][np.array(on_crease)] == 1).any()
 
 
 def test_quartic_kernel_matches_its_definition():

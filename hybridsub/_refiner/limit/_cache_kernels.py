@@ -195,50 +195,92 @@ def _back3(buf, s, t, e, end, t_row, t_col, t_val):
                 e += 1
 
 
-@kernel
-def back_rows(W, slots, block, stop, path, keys, nv, st_L, t_start, t_end, t_row, t_col, t_val, out):
-    """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
-    last patch's ``slots`` (q,) rows (stencil vertices' limit rows, or a quartic's
-    coefficients) stored at ``st_L[block:]`` (slots × nv), then back through the steps.
+@kernel(inline="always")
+def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
+              t_row, t_col, t_val):
+    """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``."""
+    nr = W.shape[1]
+    d = stop[q]
+    s = 0
+    ns = slots[q]
+    for v in range(nv[keys[q, d]]):
+        for r in range(nr):
+            buf[0, v, r] = 0.0
+    b = block[q]
+    for k in range(blk_nc[b]):
+        v = blk_col[blk_c0[b] + k]
+        off = blk_v0[b] + k * ns
+        for r in range(nr):
+            acc = 0.0
+            for j in range(ns):
+                acc += W[q, r, j] * blk_val[off + j]
+            buf[0, v, r] = acc
+    for lev in range(d - 1, -1, -1):
+        c = path[q, lev]
+        t = 1 - s
+        for v in range(nv[keys[q, lev]]):
+            for r in range(nr):
+                buf[t, v, r] = 0.0
+        e = t_start[c]
+        end = t_end[c]
+        if nr == 3:
+            _back3(buf, s, t, e, end, t_row, t_col, t_val)
+        else:
+            _back_any(buf, s, t, e, end, t_row, t_col, t_val)
+        s = t
+    return s
 
-    ``stop`` (q,) the level each point stopped at, ``path`` (q, d) the candidates chosen,
-    ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
-    """
+
+@kernel(inline="always")
+def _buffer(stop, keys, nv, nr):
+    """Room for the largest patch the points meet: this level's rows and the next's."""
     nmax = 0
     for q in range(len(stop)):
         for lev in range(stop[q] + 1):
             nmax = max(nmax, nv[keys[q, lev]])
-    nr = W.shape[1]
-    buf = np.zeros((2, nmax, nr))  # this level's rows and the next's, by turns
+    return np.zeros((2, nmax, nr))
+
+
+@kernel
+def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
+              t_col, t_val, out):
+    """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
+    last patch's ``slots`` (q,) rows (stencil vertices' limit rows, or a quartic's
+    coefficients) in the table's block ``block`` (q,) (``cache.PatchTable``'s ``blk_*``), then
+    back through the steps.
+
+    ``stop`` (q,) the level each point stopped at, ``path`` (q, d) the candidates chosen,
+    ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
+    """
+    buf = _buffer(stop, keys, nv, W.shape[1])
     for q in range(len(stop)):
-        d = stop[q]
-        s = 0
-        n = nv[keys[q, d]]
-        for v in range(n):
-            for r in range(nr):
-                buf[0, v, r] = 0.0
-        for j in range(slots[q]):
-            base = block[q] + j * n
-            for v in range(n):
-                x = st_L[base + v]
-                for r in range(nr):
-                    buf[0, v, r] += W[q, r, j] * x
-        for lev in range(d - 1, -1, -1):
-            c = path[q, lev]
-            t = 1 - s
-            for v in range(nv[keys[q, lev]]):
-                for r in range(nr):
-                    buf[t, v, r] = 0.0
-            e = t_start[c]
-            end = t_end[c]
-            if nr == 3:
-                _back3(buf, s, t, e, end, t_row, t_col, t_val)
-            else:
-                _back_any(buf, s, t, e, end, t_row, t_col, t_val)
-            s = t
+        s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                      t_end, t_row, t_col, t_val)
         for v in range(nv[keys[q, 0]]):
-            for r in range(nr):
+            for r in range(W.shape[1]):
                 out[q, v, r] = buf[s, v, r]
+
+
+@kernel
+def back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
+                t_col, t_val, base, order, vids, X, res):
+    """:func:`back_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
+    gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
+    canonical vertex ``k`` is control vertex ``vids[base[q] + k]``; ``order[base[q]:]`` lists
+    them by increasing id): the sums of the CSR product of ``walk.walk_rows``, term for term in
+    its order, so the same bits."""
+    buf = _buffer(stop, keys, nv, W.shape[1])
+    for q in range(len(stop)):
+        s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                      t_end, t_row, t_col, t_val)
+        b = base[q]
+        for k in range(nv[keys[q, 0]]):
+            loc = order[b + k]
+            col = vids[b + loc]
+            for r in range(W.shape[1]):
+                a = buf[s, loc, r]
+                for d in range(X.shape[1]):
+                    res[r, q, d] += a * X[col, d]
 
 
 @kernel
@@ -379,36 +421,95 @@ def quartic_points(bary, uv, exps, coef, W):
                                   + G[1, r1] * h12 * G[0, r2] + G[1, r1] * h22 * G[1, r2])
 
 
+#: The bits of an infinite sharpness (``face_records`` keeps sharpness as its float's bits).
+INF_BITS = np.array([np.inf]).view(np.int64)[0]
+
+
+@kernel(inline="always")
+def _crease(rec, r, h):
+    """Whether halfedge ``h`` of record ``r`` is on a crease: tagged, or a boundary."""
+    return rec[r, 3 + h] < 0 or rec[r, 7 + h] != 0
+
+
+@kernel(inline="always")
+def _infinite(rec, r, h):
+    return rec[r, 3 + h] < 0 or rec[r, 7 + h] == INF_BITS
+
+
+@kernel
+def _regular_corner(rec, a, b, c):
+    """The kind of the centre's (record ``a``) corner ``c`` for the box spline: 0 not regular,
+    1 interior (six Loop faces, no crease), 2 on a regular crease (two infinitely sharp
+    crease edges, three Loop faces between them on the centre's side)."""
+    side = 1
+    closed = False
+    ok = rec[a, 6] != 0
+    r, cc = a, c
+    while True:  # one way round: across the edges coming in to the corner
+        h = (cc + 2) % 3
+        if _crease(rec, r, h):
+            ok = ok and _infinite(rec, r, h)
+            break
+        t = rec[r, 3 + h]
+        r, cc = a + t // 3, t % 3
+        if r == a:
+            closed = True
+            break
+        side += 1
+        ok = ok and rec[r, 6] != 0
+        if side > 6:
+            return 0
+    if not closed:
+        r, cc = a, c
+        while True:  # the other way: across the edges going out
+            if _crease(rec, r, cc):
+                ok = ok and _infinite(rec, r, cc)
+                break
+            t = rec[r, 3 + cc]
+            r, cc = a + t // 3, (t % 3 + 1) % 3
+            side += 1
+            ok = ok and rec[r, 6] != 0
+            if side > 6:
+                return 0
+    if not ok:
+        return 0
+    if closed:
+        return 1 if side == 6 else 0
+    v = rec[a, c]
+    creases = 0
+    for r in range(a, b):  # every edge at v once: going out of v, or a boundary coming in
+        for k in range(3):
+            if rec[r, k] == v:
+                if _crease(rec, r, k):
+                    creases += 1
+                if rec[r, 3 + (k + 2) % 3] < 0:
+                    creases += 1
+    return 2 if side == 3 and creases == 2 else 0
+
+
 @kernel
 def regular_flags(rec, fstart, cv, vstart, out):
     """``regular.is_regular`` of every piece from its canonical records (:func:`face_records`)
     and corner flags ``cv``: ``out`` (k,) 1 or 0."""
     for i in range(len(fstart) - 1):
         a, b = fstart[i], fstart[i + 1]
-        va, vb = vstart[i], vstart[i + 1]
         ok = True
-        for v in range(va, vb):
-            if cv[v]:
+        on_crease = 0
+        last = -1
+        first = -1
+        for c in range(3):
+            kind = _regular_corner(rec, a, b, c)
+            if kind == 0 or cv[vstart[i] + rec[a, c]]:
                 ok = False
-        count = np.zeros(vb - va, np.int64)
-        opened = np.zeros(vb - va, np.bool_)
-        for r in range(a, b):
-            if rec[r, 6] == 0 or rec[r, 7] != 0 or rec[r, 8] != 0 or rec[r, 9] != 0:
-                ok = False
-            for c in range(3):
-                count[rec[r, c]] += 1
-                if rec[r, 3 + c] < 0:
-                    opened[rec[r, c]] = True
-        if ok:
-            for r in range(a, b):  # the faces touching the centre (face a): their vertices
-                touches = False
-                for c in range(3):
-                    for e in range(3):
-                        if rec[r, c] == rec[a, e]:
-                            touches = True
-                if touches:
-                    for c in range(3):
-                        v = rec[r, c]
-                        if count[v] != 6 or opened[v]:
-                            ok = False
+            elif kind == 2:
+                on_crease += 1
+                if first < 0:
+                    first = c
+                last = c
+        if ok and on_crease == 3:
+            ok = False
+        if ok and on_crease == 2:  # the centre's edge between them must be the crease
+            h = first if last == first + 1 else last
+            ok = _crease(rec, a, h)
         out[i] = 1 if ok else 0
+

@@ -126,10 +126,17 @@ class PatchTable:
         self.final = Grow((), np.int64, -1)  # per key: its stencil record (−1: none yet)
         self.regular_stop = scheme != "sqrt3"  # stop at regular Loop patches (regular.py)
         self.regular = Grow((), np.int8)  # per key: 1 a regular Loop patch (regular.is_regular), else 0
-        self.poly = Grow((), np.int64, -1)  # per regular key: its quartic's coefficients in st_L
+        self.poly = Grow((), np.int64, -1)  # per regular key: the block of its quartic's coefficients
         self.st_ids = Grow((6,), np.int64)  # per stencil record
-        self.st_L = Grow((), np.float64)  # limit rows of the six vertices, 6 × nv, from st_L0
-        self.st_L0 = Grow((), np.int64)
+        self.st_blk = Grow((), np.int64)  # per stencil record: the block of its six vertices' limit rows
+        # Blocks: rows over a patch's vertices, kept by vertex (only those where a row is not
+        # zero): block b's vertices blk_col[blk_c0[b]:][:blk_nc[b]], each with its rows' values
+        # one after another in blk_val from blk_v0[b].
+        self.blk_v0 = Grow((), np.int64)
+        self.blk_c0 = Grow((), np.int64)
+        self.blk_nc = Grow((), np.int64)
+        self.blk_col = Grow((), np.int32)
+        self.blk_val = Grow(())
         self.st_node = Grow((9,))  # c0 (2), scale (1), the face's corners (6)
         self.st_full = Grow((), np.bool_)
         self.st_inv = Grow((6, 6))  # the inverse of the interpolation matrix
@@ -279,15 +286,38 @@ class PatchTable:
         self.st_full.append(full)
         self.st_node.append(np.concatenate([c0.reshape(-1, 2), scale.reshape(-1, 1), here.reshape(-1, 6)], axis=1))
         nv = np.diff(voff)
-        starts = self.st_L.n + np.concatenate([[0], np.cumsum(6 * nv)[:-1]])
+        starts = np.concatenate([[0], np.cumsum(6 * nv)[:-1]])
         flat = np.zeros(int(6 * nv.sum()))
         Lr = L[np.maximum(ids, 0).ravel()].tocoo()  # row 6 i + j: key i's slot j
         ok = (ids.ravel() >= 0)[Lr.row]
         key = Lr.row[ok] // 6
-        np.add.at(flat, starts[key] - self.st_L.n + (Lr.row[ok] % 6) * nv[key] + Lr.col[ok] - voff[key], Lr.data[ok])
-        self.st_L.append(flat)
-        self.st_L0.append(starts)
+        np.add.at(flat, starts[key] + (Lr.row[ok] % 6) * nv[key] + Lr.col[ok] - voff[key], Lr.data[ok])
+        self.st_blk.append(self.add_blocks(flat, 6, nv))
         self.final.a[keys] = rec + np.arange(len(keys))
+
+    def add_blocks(self, dense: np.ndarray, rows: int, nv: np.ndarray) -> np.ndarray:
+        """Store blocks given one after another in ``dense``, block ``i`` (rows × nv[i]); returns
+        their ids. Vertices where every row is zero are left out."""
+        k = len(nv)
+        size = rows * nv
+        starts = np.concatenate([[0], np.cumsum(size)])
+        cstart = np.concatenate([[0], np.cumsum(nv)])
+        blk = np.repeat(np.arange(k), size)
+        pos = np.arange(len(dense)) - starts[blk]
+        live = np.zeros(int(cstart[-1]), bool)
+        live[(cstart[blk] + pos % nv[blk])[dense != 0]] = True
+        kept = np.flatnonzero(live)
+        bk = np.searchsorted(cstart, kept, side="right") - 1
+        col = kept - cstart[bk]
+        nc = np.bincount(bk, minlength=k)
+        vals = dense[starts[bk][:, None] + np.arange(rows)[None, :] * nv[bk][:, None] + col[:, None]]
+        ids = self.blk_nc.n + np.arange(k)
+        self.blk_v0.append(self.blk_val.n + rows * np.concatenate([[0], np.cumsum(nc)[:-1]]))
+        self.blk_c0.append(self.blk_col.n + np.concatenate([[0], np.cumsum(nc)[:-1]]))
+        self.blk_nc.append(nc)
+        self.blk_col.append(col)
+        self.blk_val.append(vals.ravel())
+        return ids
 
 
 def _sorted(a: np.ndarray) -> bool:

@@ -1,8 +1,14 @@
 """Regular Loop patches: where the walk may stop.
 
-Over a face whose three corners and their neighbours are interior Loop vertices of valence
-6, with no tag (crease, corner) among the patch's edges and vertices, the Loop limit surface
-is one quartic polynomial (the box spline) of the face's barycentric coordinates. The walk
+Over a face whose three corners are untagged interior Loop vertices of valence 6 with no
+crease, the Loop limit surface is one quartic polynomial (the box spline of the corners'
+twelve neighbours) of the face's barycentric coordinates: the limit over a face depends only
+on its corners' rules and those of the edges at its corners, whatever the neighbours'
+valences and tags. So it is on one side of a straight infinitely sharp crease (or boundary):
+a corner on it with exactly two crease edges and three Loop faces between them on the face's
+side follows the crease rules, which are the regular rules applied to "phantom" vertices
+mirrored across the crease (c' = a + v − c), and the mirroring persists under refinement; the
+face's corners on the crease, if two, must be joined by the crease. The walk
 (:mod:`.walk`) stops at such a patch: the polynomial is the one through the exact limit
 positions of the 15 vertices of the face's second refinement (barycentric coordinates i/4),
 found by the walk itself (two levels down, where each is a vertex and takes its limit mask),
@@ -63,12 +69,51 @@ def polynomial_weights(bary: np.ndarray, uv: np.ndarray, n_rows: int) -> np.ndar
 
 
 def is_regular(F: np.ndarray, twin: np.ndarray, hsharp, face_sharp: np.ndarray, corner: np.ndarray) -> bool:
-    """Whether a patch (canonical: its centre is face 0) is a regular Loop patch: every face
-    Loop, no tag, and the centre's corners and their neighbours interior of valence 6."""
-    if hsharp is not None or corner.any() or not face_sharp.all():
+    """Whether a patch (canonical: its centre is face 0) is a regular Loop patch (see the
+    module doc): each of the centre's corners untagged with six Loop faces and no crease, or
+    on a straight infinitely sharp crease (exactly two crease edges, three Loop faces between
+    them on the centre's side); crease corners, if two, joined by the centre's edge."""
+    sharp = np.zeros(3 * len(F)) if hsharp is None else np.asarray(hsharp, dtype=np.float64)
+    crease = (twin < 0) | (sharp != 0)
+    kinds = []
+    for v in F[0]:
+        if corner[v]:
+            return False
+        faces = np.flatnonzero((F == v).any(axis=1))
+        # The edges at v, as vertex pairs, with whether each is a crease and infinitely sharp.
+        edges = {}
+        for f in faces:
+            for k in range(3):
+                a, b = F[f, k], F[f, (k + 1) % 3]
+                if v in (a, b):
+                    e = (min(a, b), max(a, b))
+                    c, inf = edges.get(e, (False, True))
+                    h = 3 * f + k
+                    edges[e] = (c or crease[h], inf and (twin[h] < 0 or sharp[h] == np.inf))
+        creases = [e for e, (c, _) in edges.items() if c]
+        # The centre's side: faces at v reached from it across edges at v that are not creases.
+        side, todo = {0}, [0]
+        while todo:
+            f = todo.pop()
+            for g in faces:
+                shared = set(F[f]) & set(F[g])
+                if g not in side and len(shared) == 2:
+                    e = tuple(sorted(shared))
+                    if v in e and not edges[e][0]:
+                        side.add(g)
+                        todo.append(g)
+        if not face_sharp[list(side)].all():
+            return False
+        if not creases and len(faces) == 6 and len(edges) == 6:
+            kinds.append(False)
+        elif len(creases) == 2 and all(edges[e][1] for e in creases) and len(side) == 3:
+            kinds.append(True)
+        else:
+            return False
+    on = [v for v, k in zip(F[0], kinds) if k]
+    if len(on) == 3:
         return False
-    ring = np.unique(F[np.isin(F, F[0]).any(axis=1)])
-    faces_at = np.bincount(F.ravel(), minlength=len(corner))
-    open_at = np.zeros(len(corner), bool)
-    open_at[F.ravel()[twin < 0]] = True  # the start of a boundary halfedge
-    return bool((faces_at[ring] == 6).all() and not open_at[ring].any())
+    if len(on) == 2:
+        k = [i for i in range(3) if {F[0, i], F[0, (i + 1) % 3]} == set(on)][0]
+        return bool(crease[k])
+    return True

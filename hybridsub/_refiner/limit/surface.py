@@ -10,7 +10,7 @@ from ..._input import as_vertices, open_gate
 from ..._typing import ArrayLike, LoopWeights, Scheme
 from .cache import PatchTable
 from .project import closest_points, seed_setup
-from .walk import StartKeys, walk_rows
+from .walk import StartKeys, walk_points, walk_rows
 
 #: Points followed down together (bounds the memory of one pass).
 CHUNK = 20000
@@ -152,13 +152,19 @@ class LimitSurface:
         """
         return self._matrix(*self._points(face, bary), derivatives, self.depth)
 
-    def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
-        parts = [[] for _ in range([1, 3, 6][int(derivatives)])]
+    def _chunks(self, f: np.ndarray, b: np.ndarray, work) -> list:
+        """``work(f, b)`` on chunks of ``CHUNK`` points; the patch cache emptied before a chunk
+        once it holds more than ``CACHE_BYTES``."""
+        out = []
         for i in range(0, len(f), CHUNK):
             if self._table.nbytes > CACHE_BYTES:
                 self._new_cache()
-            for acc, R in zip(parts, self._rows(f[i:i + CHUNK], b[i:i + CHUNK], derivatives, depth)):
-                acc.append(R)
+            out.append(work(f[i:i + CHUNK], b[i:i + CHUNK]))
+        return out
+
+    def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
+        chunks = self._chunks(f, b, lambda fc, bc: self._rows(fc, bc, derivatives, depth))
+        parts = list(zip(*chunks)) or [()] * [1, 3, 6][int(derivatives)]
         n = self._inp.n_vertices
         mats = [a[0] if len(a) == 1 else sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
         for M in mats:
@@ -186,10 +192,14 @@ class LimitSurface:
         True
         """
         X = self._data(vertices)
-        mats = self.evaluation_matrix(face, bary, derivatives)
-        if derivatives:
-            return tuple(np.asarray(M @ X) for M in mats)
-        return np.asarray(mats @ X)
+        f, b = self._points(face, bary)
+        n_rows = 3 if derivatives else 1
+        X2 = np.ascontiguousarray(X.reshape(len(X), -1))
+        parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
+                                                              self.depth, X2))
+        res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
+        res = res.reshape((n_rows, len(f)) + X.shape[1:])
+        return tuple(res) if derivatives else res[0]
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
         """Unit normals ``∂P/∂u × ∂P/∂v`` (k, 3) (one-sided at creases: the given face's side).

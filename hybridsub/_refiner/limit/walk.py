@@ -15,10 +15,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput
-from ._cache_kernels import back_rows, pick_children, stencil_points
+from ._cache_kernels import back_points, back_rows, pick_children, stencil_points
 from .cache import Grow, PatchTable
 from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights
+
+
+def _corners(q: int) -> np.ndarray:
+    """The input face's corners in (u, v), for ``q`` points."""
+    return np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
 
 
 class StartKeys:
@@ -84,9 +89,9 @@ def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool)
     return keys, path, stop, bary, uv
 
 
-def walk(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
-    """Rows (q, nv_max, n_rows) of the points over their first patches' canonical vertices:
-    value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v²."""
+def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
+    """The walk down (:func:`_descend`) and each point's weights on its last patch: the
+    arguments of :func:`._cache_kernels.back_rows` before its output."""
     q = len(keys0)
     keys, path, stop, bary, uv = _descend(table, keys0, bary.copy(), uv.copy(), depth, stop_regular)
     last = keys[np.arange(q), stop]
@@ -108,11 +113,18 @@ def walk(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regul
         Ws = np.empty((len(st), n_rows, 6))
         stencil_points(rec, bary[st], uv[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
         W[st, :, :6] = Ws
-        block[st] = table.st_L0.a[rec]
-    nv = table.nv.a
-    out = np.zeros((q, int(nv[keys0].max()) if q else 0, n_rows))
-    back_rows(W, np.where(poly, 15, 6), block, stop, path, keys, nv, table.st_L.a, table.t_start.a,
-              table.t_end.a, table.t_row.a, table.t_col.a, table.t_val.a, out)
+        block[st] = table.st_blk.a[rec]
+    return (W, np.where(poly, 15, 6), block, stop, path, keys, table.nv.a, table.blk_v0.a, table.blk_c0.a,
+            table.blk_nc.a, table.blk_col.a, table.blk_val.a, table.t_start.a, table.t_end.a, table.t_row.a,
+            table.t_col.a, table.t_val.a)
+
+
+def walk(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
+    """Rows (q, nv_max, n_rows) of the points over their first patches' canonical vertices:
+    value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v²."""
+    args = _last_weights(table, keys0, bary, uv, n_rows, depth, stop_regular)
+    out = np.zeros((len(keys0), int(table.nv.a[keys0].max()) if len(keys0) else 0, n_rows))
+    back_rows(*args, out)
     return out
 
 
@@ -122,12 +134,10 @@ def fill_polynomials(table: PatchTable, keys: np.ndarray):
     if not len(keys):
         return
     k = len(keys)
-    uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], 15 * k, axis=0)
-    rows = walk(table, np.repeat(keys, 15), np.tile(GRID, (k, 1)), uv, 1, 2, False)[:, :, 0]
+    rows = walk(table, np.repeat(keys, 15), np.tile(GRID, (k, 1)), _corners(15 * k), 1, 2, False)[:, :, 0]
     coef = GRID_INVERSE @ rows.reshape(k, 15, -1)  # (k, 15, nv_max)
     nv = table.nv.a[keys]
-    table.poly.a[keys] = table.st_L.n + np.concatenate([[0], np.cumsum(15 * nv)[:-1]])
-    table.st_L.append(np.concatenate([coef[i, :, :nv[i]].ravel() for i in range(k)]))
+    table.poly.a[keys] = table.add_blocks(np.concatenate([coef[i, :, :nv[i]].ravel() for i in range(k)]), 15, nv)
 
 
 def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
@@ -136,10 +146,9 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     matrix)."""
     q = len(f)
     keys0 = starts.of(f)
-    uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
-    out = walk(table, keys0, b, uv, n_rows, depth, table.regular_stop)
-    # Onto the control vertices: each point's first patch, by increasing vertex id.
+    out = walk(table, keys0, b, _corners(q), n_rows, depth, table.regular_stop)
     nv0 = table.nv.a[keys0]
+    # Onto the control vertices: each point's first patch, by increasing vertex id.
     row, k = np.nonzero(np.arange(out.shape[1])[None, :] < nv0[:, None])
     base = starts.v0[f][row]
     loc = starts.order.a[base + k]
@@ -152,3 +161,14 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
         M.has_canonical_format = True  # sorted, no duplicates: one patch's distinct vertices
         mats.append(M)
     return mats
+
+
+def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int,
+                X: np.ndarray) -> np.ndarray:
+    """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the matrices, with
+    the same bits."""
+    keys0 = starts.of(f)
+    args = _last_weights(table, keys0, b, _corners(len(f)), n_rows, depth, table.regular_stop)
+    res = np.zeros((n_rows, len(f), X.shape[1]))
+    back_points(*args, starts.v0[f], starts.order.a, starts.vids.a, X, res)
+    return res
