@@ -111,44 +111,81 @@ def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, entry, 
         out[r, 12] = round(norm[r, 2, 1] / grid)
 
 
-@kernel
-def pick_children(key, bary, uv, cand_start, cand_count, M, chosen, bary_out, uv_out):
-    """One level of the walk: every point's child face among its key's candidates (the
-    largest smallest barycentric coordinate; the first of those equal to ``TIE``, so a
-    point on an edge stays on the centre face's side), its coordinates there and
-    the child's corners in (u, v). ``M`` (c, 3, 3) takes a point's barycentric coordinates
-    into each candidate's; its inverse transposed holds the candidate's corners over the
-    face. ``chosen`` gets the candidate, −1 where the key has no candidates yet."""
-    b = np.empty(3)
-    G = np.empty((3, 3))
-    for q in range(len(key)):
-        s = cand_start[key[q]]
-        chosen[q] = -1
-        if s < 0:
-            continue
-        best = -np.inf
-        for j in range(s, s + cand_count[key[q]]):
-            lo = np.inf
-            for i in range(3):
-                b[i] = M[j, i, 0] * bary[q, 0] + M[j, i, 1] * bary[q, 1] + M[j, i, 2] * bary[q, 2]
-                lo = min(lo, b[i])
-            if lo > best + TIE:
-                best = lo
-                chosen[q] = j
-                bary_out[q, :] = b
-        j = chosen[q]
-        # G = (Mᵀ)⁻¹: the cofactors of M over its determinant.
-        det = (M[j, 0, 0] * (M[j, 1, 1] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 1])
-               - M[j, 0, 1] * (M[j, 1, 0] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 0])
-               + M[j, 0, 2] * (M[j, 1, 0] * M[j, 2, 1] - M[j, 1, 1] * M[j, 2, 0]))
+@kernel(inline="always")
+def _pick_one(q, k, bary, uv, cand_start, cand_count, M, b):
+    """Point ``q``'s child face among key ``k``'s candidates (the largest smallest barycentric
+    coordinate; the first of those equal to ``TIE``, so a point on an edge stays on the
+    centre face's side): its coordinates there and the child's corners in (u, v) replace
+    ``bary[q]`` and ``uv[q]``. ``M`` (c, 3, 3) takes a point's barycentric coordinates into
+    each candidate's; its inverse transposed holds the candidate's corners over the face.
+    Returns the candidate."""
+    s = cand_start[k]
+    best = -np.inf
+    chosen = -1
+    nb0 = nb1 = nb2 = 0.0
+    for j in range(s, s + cand_count[k]):
+        lo = np.inf
+        for i in range(3):
+            b[i] = M[j, i, 0] * bary[q, 0] + M[j, i, 1] * bary[q, 1] + M[j, i, 2] * bary[q, 2]
+            lo = min(lo, b[i])
+        if lo > best + TIE:
+            best = lo
+            chosen = j
+            nb0, nb1, nb2 = b[0], b[1], b[2]
+    j = chosen
+    bary[q, 0], bary[q, 1], bary[q, 2] = nb0, nb1, nb2
+    # G = (Mᵀ)⁻¹: the cofactors of M over its determinant.
+    det = (M[j, 0, 0] * (M[j, 1, 1] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 1])
+           - M[j, 0, 1] * (M[j, 1, 0] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 0])
+           + M[j, 0, 2] * (M[j, 1, 0] * M[j, 2, 1] - M[j, 1, 1] * M[j, 2, 0]))
+    for d in range(2):
+        u0, u1, u2 = uv[q, 0, d], uv[q, 1, d], uv[q, 2, d]
         for a in range(3):
             a1, a2 = (a + 1) % 3, (a + 2) % 3
-            for c in range(3):
-                c1, c2 = (c + 1) % 3, (c + 2) % 3
-                G[a, c] = (M[j, a1, c1] * M[j, a2, c2] - M[j, a1, c2] * M[j, a2, c1]) / det
-        for i in range(3):
-            for d in range(2):
-                uv_out[q, i, d] = G[i, 0] * uv[q, 0, d] + G[i, 1] * uv[q, 1, d] + G[i, 2] * uv[q, 2, d]
+            g0 = (M[j, a1, 1] * M[j, a2, 2] - M[j, a1, 2] * M[j, a2, 1]) / det
+            g1 = (M[j, a1, 2] * M[j, a2, 0] - M[j, a1, 0] * M[j, a2, 2]) / det
+            g2 = (M[j, a1, 0] * M[j, a2, 1] - M[j, a1, 1] * M[j, a2, 0]) / det
+            b[a] = g0 * u0 + g1 * u1 + g2 * u2
+        for a in range(3):
+            uv[q, a, d] = b[a]
+    return j
+
+
+@kernel
+def walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_count, M, child, regular,
+               stop_regular, depth):
+    """The walk (``walk._descend``) of the points ``todo`` as far as the table knows the way.
+
+    Point ``q`` is at ``level[q]`` on key ``keys[q, level[q]]`` (``state[q]`` 1: it has
+    chosen ``path[q, level[q]]`` there, whose child patch was not cut yet). It goes down,
+    choosing a child per level (``_pick_one``), to ``depth`` or (with ``stop_regular``) to
+    the first regular key, and then ``stop[q]`` is set and ``state[q]`` 0; or it halts at a
+    key whose candidates are not known (``state[q]`` 2) or at a candidate whose child patch is
+    not cut (``state[q]`` 1) for the caller to fill the table and call again."""
+    b = np.empty(3)
+    for i in range(len(todo)):
+        q = todo[i]
+        lev = level[q]
+        if state[q] == 1:
+            keys[q, lev + 1] = child[path[q, lev]]
+            lev += 1
+        state[q] = 0
+        while True:
+            k = keys[q, lev]
+            if (stop_regular and regular[k] == 1) or lev == depth:
+                stop[q] = lev
+                break
+            if cand_start[k] < 0:
+                state[q] = 2
+                break
+            j = _pick_one(q, k, bary, uv, cand_start, cand_count, M, b)
+            path[q, lev] = j
+            if child[j] < 0:
+                state[q] = 1
+                break
+            keys[q, lev + 1] = child[j]
+            lev += 1
+        level[q] = lev
 
 
 @kernel(inline="always")

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput
-from ._cache_kernels import back_points, back_rows, pick_children, stencil_points
+from ._cache_kernels import back_points, back_rows, stencil_points, walk_known
 from .cache import Grow, PatchTable
 from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights
@@ -52,40 +52,30 @@ class StartKeys:
         return self.key[faces]
 
 
-def _pick(table: PatchTable, key, bary, uv):
-    """One level for every point: the candidate chosen, the point's barycentric coordinates
-    in it and its corners in (u, v); keys met for the first time are refined first."""
-    lack = key[table.cand_start.a[key] < 0]
-    if len(lack):
-        table.fill_steps(np.unique(lack))
-    chosen = np.empty(len(key), np.int64)
-    nb, nuv = np.empty_like(bary), np.empty_like(uv)
-    pick_children(key, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a, chosen, nb, nuv)
-    miss = table.child.a[chosen] < 0
-    if miss.any():
-        table.fill_children(np.unique(chosen[miss]))
-    return chosen, nb, nuv
-
-
 def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool):
     """Every point down to ``depth`` levels, or to the first regular Loop patch (with
     ``stop_regular``). Returns the keys met (q, depth + 1), the candidates chosen (q, depth),
-    the level each point stopped at, and its barycentric coordinates and (u, v) corners there."""
+    the level each point stopped at, and its barycentric coordinates and (u, v) corners there
+    (``bary``, ``uv`` updated in place). The walk goes as far as the table knows the way; keys
+    and child patches met for the first time are refined in a batch, and the walk goes on."""
     q = len(keys0)
     keys = np.empty((q, depth + 1), np.int64)
     path = np.empty((q, depth), np.int64)
     stop = np.full(q, depth, np.int64)
     keys[:, 0] = keys0
-    live = np.arange(q)
-    for lev in range(depth + 1):
-        if stop_regular:
-            reg = table.regular_keys(keys[live, lev])
-            stop[live[reg]] = lev
-            live = live[~reg]
-        if lev == depth or not len(live):
-            break
-        path[live, lev], bary[live], uv[live] = _pick(table, keys[live, lev], bary[live], uv[live])
-        keys[live, lev + 1] = table.child.a[path[live, lev]]
+    level = np.zeros(q, np.int64)
+    state = np.zeros(q, np.int8)
+    todo = np.arange(q)
+    while len(todo):
+        walk_known(todo, level, state, keys, path, stop, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a,
+                   table.child.a, table.regular.a, stop_regular, depth)
+        todo = todo[state[todo] != 0]
+        steps = todo[state[todo] == 2]
+        if len(steps):
+            table.fill_steps(np.unique(keys[steps, level[steps]]))
+        cut = todo[state[todo] == 1]
+        if len(cut):
+            table.fill_children(np.unique(path[cut, level[cut]]))
     return keys, path, stop, bary, uv
 
 
