@@ -145,6 +145,7 @@ def test_bad_arguments():
         analysis.closed_form_spectrum(0, "loop", crease=True)
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_figure_script_runs(tmp_path):
     """docs/figures/make_figures.py, in its quick mode: the docs' figures can be regenerated."""
     pytest.importorskip("matplotlib")

@@ -397,6 +397,7 @@ def test_killed_worker_mid_batch(collection, reference, cluster, tmp_path, capfd
     _check_outputs(root, outdir, good, reference, _records(outdir))
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_killed_run_resumes(collection, reference, cluster, tmp_path):
     """``hybridsub batch`` killed with SIGKILL (client, scheduler and workers) after a few meshes,
     the manifest's WAL left behind: the rerun redoes only the unfinished meshes."""
@@ -483,6 +484,7 @@ def test_memory_guard_uses_the_worker_limit(cluster, tmp_path):
 # formats, the command line, the local cluster
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_cli_local_cluster_ply_and_npz(collection, tmp_path, capsys):
     """``hybridsub batch`` starting its own cluster, PLY and NPZ outputs equal to ``subdivide``'s,
     exit code 1 for a failed mesh, 0 when all are done or skipped."""

@@ -98,6 +98,7 @@ def test_error_messages(tmp_path, capsys):
     assert "1 non-manifold edge (in 3+ faces; at vertices 0–1)" in out and "refuses this mesh" in out
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_compare_writes_the_figure(tmp_path):
     fig = tmp_path / "cmp.png"
     r = run("compare", off("cube-meshed"), "-o", fig, "--levels", 1, "--size", "640x300", "--view", "30,25",
@@ -447,6 +448,7 @@ def _textured_bunny(tmp_path):
     return str(path), V, F, UV, FUV
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_textured_obj_round_trips(tmp_path, capsys):
     """vt and f v/vt in, seams refined face-varying, vt and f v/vt out: what
     subdivide_face_varying gives, to the bit (OBJ floats are written as repr)."""

@@ -107,6 +107,7 @@ CALL = ("from rulepkg.kernels import keyed, plain\n"
         "print(keyed(1.0), plain(1.0), keyed.stats.cache_hits[keyed.signatures[0]])")
 
 
+@pytest.mark.slow  # subprocesses / a cluster / figures: ~4-11 s; .ci/run runs the slow tests
 def test_an_edited_rule_recompiles_a_warm_kernel(tmp_path):
     """A small package: ``keyed`` (``hybridsub._jit.kernel``) and ``plain`` (Numba's own cache)
     both compile in a rule and a constant from another module. After the rule is edited,
