@@ -157,11 +157,36 @@ def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
     t = s._table
     flags = [is_regular(F_, tw, hs, fs, c) for F_, tw, hs, fs, c, _ in t.reps]  # the kernel's definition
     assert np.array_equal(t.regular.a[:t.n_keys], np.array(flags, np.int8))
-    if mesh != "octahedron":
+    # Regular input faces take the box spline straight from their twelve control vertices:
+    # those whose corners are interior, of valence 6, on no crease, with Loop faces only.
+    faces_at = np.bincount(F.ravel(), minlength=len(V))
+    E = np.sort(np.stack([F, np.roll(F, -1, axis=1)], 2).reshape(-1, 2), axis=1)
+    e, count = np.unique(E, axis=0, return_counts=True)
+    bad = faces_at != 6
+    bad[e[count == 1].ravel()] = True
+    bad[np.asarray(kw.get("sharp_edges", np.zeros((0, 2), int))).ravel()] = True
+    loop_face = np.asarray(kw.get("sharp_faces", np.ones(len(F), bool)))
+    bad[F[~loop_face].ravel()] = True
+    fast = s._starts.rings[:, 0] >= 0
+    assert np.array_equal(fast, ~bad[F].any(axis=1))
+    if fast.any():
+        assert np.array_equal(np.sort(s._starts.rings[fast], axis=1), _one_rings(F, np.flatnonzero(fast)))
+    if mesh == "torus":
+        assert fast.all() and t.n_keys == 0  # no patch was cut
+    elif mesh != "octahedron":
         assert t.regular.a[:t.n_keys].max() == 1 and (t.poly.a[:t.n_keys] >= 0).any()
     if mesh in ("torus-crease", "grid-boundary", "torus-hybrid"):  # some regular keys: a crease at the centre
         on_crease = [(r[1][:3] < 0).any() or (r[2] is not None and r[2][:3].any()) for r in t.reps]
         assert (t.regular.a[:t.n_keys][np.array(on_crease)] == 1).any()
+
+
+def _one_rings(F, faces):
+    """The vertices of the faces sharing a vertex with each face, (k, 12) for regular faces."""
+    out = []
+    for f in faces:
+        near = np.isin(F, F[f]).any(axis=1)
+        out.append(np.unique(F[near]))
+    return np.array(out)
 
 
 def test_quartic_kernel_matches_its_definition():

@@ -550,3 +550,50 @@ def regular_flags(rec, fstart, cv, vstart, out):
             ok = _crease(rec, a, h)
         out[i] = 1 if ok else 0
 
+
+
+@kernel
+def regular_rings(F, twin, hsharp, face_sharp, corner, out):
+    """The twelve control vertices of every regular face (``regular.is_regular`` at level 0,
+    interior: each corner untagged with six Loop faces and no crease): its corners, then
+    each corner's other neighbours going round it (across the edge coming in to it) from the
+    face, each vertex once. ``out`` (m, 12) gets them, −1 rows for the other faces."""
+    ring = np.empty(12, np.int64)
+    for f in range(len(F)):
+        out[f, :] = -1
+        n = 3
+        for c in range(3):
+            ring[c] = F[f, c]
+        ok = face_sharp[f]
+        for c in range(3):
+            v = F[f, c]
+            if corner[v]:
+                ok = False
+            g, cc = f, c
+            faces = 0
+            while ok:
+                w = F[g, (cc + 1) % 3]
+                seen = False
+                for i in range(n):
+                    if ring[i] == w:
+                        seen = True
+                if not seen:
+                    if n == 12:
+                        ok = False
+                        break
+                    ring[n] = w
+                    n += 1
+                h_in = 3 * g + (cc + 2) % 3
+                t = twin[h_in]
+                if t < 0 or hsharp[h_in] != 0.0 or hsharp[3 * g + cc] != 0.0 or not face_sharp[g]:
+                    ok = False
+                    break
+                g, cc = t // 3, t % 3
+                faces += 1
+                if g == f or faces > 6:
+                    break
+            if faces != 6 or g != f:
+                ok = False
+        if ok and n == 12:
+            for i in range(12):
+                out[f, i] = ring[i]

@@ -55,6 +55,17 @@ def bernstein(bary: np.ndarray, order: int = 0):
     return out
 
 
+def regular_torus(n: int = 6):
+    """A closed n × n torus grid of triangles, every vertex of valence 6: ``V``, ``F``."""
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    a, b = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / n
+    V = np.stack([(2 + np.cos(b)) * np.cos(a), (2 + np.cos(b)) * np.sin(a), np.sin(b)], 1)
+    x, y = i.ravel(), j.ravel()
+    ids = [x * n + y, (x + 1) % n * n + y, (x + 1) % n * n + (y + 1) % n, x * n + (y + 1) % n]
+    F = np.concatenate([np.stack([ids[0], ids[1], ids[2]], 1), np.stack([ids[0], ids[2], ids[3]], 1)])
+    return V, F
+
+
 #: Coefficients from values at GRID: c = GRID_INVERSE @ values.
 GRID_INVERSE = np.linalg.inv(bernstein(GRID)[0])
 

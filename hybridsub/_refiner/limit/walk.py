@@ -11,14 +11,16 @@ control vertices: the same products as ``LimitSurface``'s direct descent, in ano
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import RefineInput
-from ._cache_kernels import back_points, back_rows, stencil_points, walk_known
+from ..._input import RefineInput, open_gate
+from ._cache_kernels import back_points, back_rows, regular_rings, stencil_points, walk_known
 from .cache import Grow, PatchTable
 from .descent import start
-from .regular import GRID, GRID_INVERSE, polynomial_weights
+from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
 
 
 def _corners(q: int) -> np.ndarray:
@@ -36,6 +38,21 @@ class StartKeys:
         self.v0 = np.zeros(inp.n_faces, np.int64)
         self.vids = Grow((), np.int64)
         self.order = Grow((), np.int64)  # per face: its canonical positions by increasing vertex id
+        self._rings = None
+
+    @property
+    def rings(self) -> np.ndarray:
+        """The twelve control vertices of each regular input face, −1 rows elsewhere
+        (:func:`._cache_kernels.regular_rings`; all −1 when the table does not stop at
+        regular patches)."""
+        if self._rings is None:
+            lvl, m = self.inp.level, self.inp.n_faces
+            self._rings = np.full((m, 12), -1, np.int64)
+            if self.table.regular_stop:
+                hs = np.zeros(3 * m) if lvl.hsharp is None else np.ascontiguousarray(lvl.hsharp, dtype=np.float64)
+                regular_rings(np.ascontiguousarray(lvl.faces, dtype=np.int64), np.ascontiguousarray(lvl.twin, np.int64),
+                              hs, lvl.face_sharp, self.inp.corner, self._rings)
+        return self._rings
 
     def of(self, faces: np.ndarray) -> np.ndarray:
         new = np.unique(faces[self.key[faces] < 0])
@@ -130,10 +147,37 @@ def fill_polynomials(table: PatchTable, keys: np.ndarray):
     table.poly.a[keys] = table.add_blocks(np.concatenate([coef[i, :, :nv[i]].ravel() for i in range(k)]), 15, nv)
 
 
+def _ring_rows(rings: np.ndarray, b: np.ndarray, n_rows: int, n: int) -> list:
+    """The rows of points on regular input faces (their rings ``rings`` (q, 12)): the box
+    spline's quartic (:func:`ring_coefficients`) at ``b``, as CSR matrices (q, n)."""
+    q = len(rings)
+    R = polynomial_weights(b, _corners(q), n_rows) @ ring_coefficients()  # (q, n_rows, 12)
+    order = np.argsort(rings, axis=1)
+    cols = np.take_along_axis(rings, order, axis=1).ravel()
+    indptr = np.arange(0, 12 * q + 1, 12)
+    mats = []
+    for r in range(n_rows):
+        M = sp.csr_matrix((np.take_along_axis(R[:, r], order, axis=1).ravel(), cols, indptr), shape=(q, n))
+        M.has_canonical_format = True
+        mats.append(M)
+    return mats
+
+
 def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
     """Rows over the control vertices of the points (face ``f``, bary ``b``): value, then
     ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR
-    matrix)."""
+    matrix). Points on regular input faces take the box spline directly."""
+    n = starts.inp.n_vertices
+    rings = starts.rings[f]
+    fast = rings[:, 0] >= 0
+    if fast.any():
+        rest = np.flatnonzero(~fast)
+        where = np.empty(len(f), np.int64)  # each point's row in [rest; fast]
+        where[rest] = np.arange(len(rest))
+        where[fast] = len(rest) + np.arange(int(fast.sum()))
+        slow = walk_rows(table, starts, f[rest], b[rest], n_rows, depth) if len(rest) else [None] * n_rows
+        quick = _ring_rows(rings[fast], b[fast], n_rows, n)
+        return [sp.csr_matrix(sp.vstack([a, c] if a is not None else [c]))[where] for a, c in zip(slow, quick)]
     q = len(f)
     keys0 = starts.of(f)
     out = walk(table, keys0, b, _corners(q), n_rows, depth, table.regular_stop)
@@ -144,7 +188,6 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     loc = starts.order.a[base + k]
     cols = starts.vids.a[base + loc]
     indptr = np.concatenate([[0], np.cumsum(nv0)])
-    n = starts.inp.n_vertices
     mats = []
     for r in range(n_rows):
         M = sp.csr_matrix((out[row, loc, r], cols, indptr), shape=(q, n))
@@ -155,10 +198,41 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
 
 def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int,
                 X: np.ndarray) -> np.ndarray:
-    """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the matrices, with
-    the same bits."""
-    keys0 = starts.of(f)
-    args = _last_weights(table, keys0, b, _corners(len(f)), n_rows, depth, table.regular_stop)
+    """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the walk's
+    matrices, with the same bits."""
     res = np.zeros((n_rows, len(f), X.shape[1]))
-    back_points(*args, starts.v0[f], starts.order.a, starts.vids.a, X, res)
+    rings = starts.rings[f]
+    fast = rings[:, 0] >= 0
+    if fast.any():
+        for r, M in enumerate(_ring_rows(rings[fast], b[fast], n_rows, starts.inp.n_vertices)):
+            res[r, fast] = M @ X
+    rest = np.flatnonzero(~fast)
+    if len(rest):
+        keys0 = starts.of(f[rest])
+        args = _last_weights(table, keys0, b[rest], _corners(len(rest)), n_rows, depth, table.regular_stop)
+        part = np.zeros((n_rows, len(rest), X.shape[1]))
+        back_points(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
+        res[:, rest] = part
     return res
+
+
+@functools.cache
+def ring_coefficients() -> np.ndarray:
+    """The quartic's 15 Bernstein coefficients (:mod:`.regular`) over the twelve control
+    vertices of a regular face, in the order of :func:`._cache_kernels.regular_rings`: the
+    walk's own quartic on a face of a regular torus (the same for every regular face; Loop's
+    and Warren's weights agree at valence 6), rounded to the 24ths they are."""
+    V, F = regular_torus()
+    inp = open_gate(F, None, 0, n_vertices=len(V), scheme="loop")
+    table = PatchTable("loop", "loop")
+    starts = StartKeys(inp, table)
+    ring = starts.rings[0]
+    keys0 = starts.of(np.zeros(15, np.int64))
+    out = walk(table, keys0, GRID.copy(), _corners(15), 1, 2, True)[:, :, 0]  # (15, nv): on the first patch
+    vids = starts.vids.a[starts.v0[0]:][:out.shape[1]]
+    M = np.zeros((15, inp.n_vertices))
+    M[:, vids] = out
+    assert not M[:, np.setdiff1d(np.arange(inp.n_vertices), ring)].any()  # the box spline's support
+    C = 24 * (GRID_INVERSE @ M[:, ring])
+    assert np.abs(C - np.round(C)).max() < 1e-9  # the box spline's coefficients are k / 24: exactly so
+    return np.round(C) / 24
