@@ -165,12 +165,15 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
             else:
                 UV = linear_uv_apply(s.uv.level, s.uv.plan, UV)
         if not tags and s.uv is None:
-            yield LevelOutput(s.step, X, s.faces, None, None, None, None)
-            continue
-        pairs, sharp = child_creases(s.level, s.plan)
-        uv_faces = s.uv.faces if s.uv is not None else None
-        yield LevelOutput(s.step, X, s.faces, face_parents(s.offsets), pairs, sharp, s.child.face_sharp, UV,
-                          uv_faces)
+            out = LevelOutput(s.step, X, s.faces, None, None, None, None)
+        else:
+            pairs, sharp = child_creases(s.level, s.plan)
+            uv_faces = s.uv.faces if s.uv is not None else None
+            out = LevelOutput(s.step, X, s.faces, face_parents(s.offsets), pairs, sharp, s.child.face_sharp, UV,
+                              uv_faces)
+        del s  # the step's plan is not held while the next step is planned
+        yield out
+        del out
 
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,

@@ -43,7 +43,7 @@ class Step(NamedTuple):
     plan: StepPlan
     faces: np.ndarray  # faces of level k + 1
     child: Level | None  # level k + 1 (None for the last step unless asked for)
-    offsets: np.ndarray  # (m + 1,) child offsets of the faces of level k
+    offsets: np.ndarray | None  # (m + 1,) child offsets of the faces of level k (None: last step, no topology)
     uv: UVStep | None  # with face-varying data
 
 
@@ -61,6 +61,7 @@ def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = T
         for s in _steps(inp, budget, topology_last):
             yield s
             tick(bar, len(s.faces))
+            del s  # nor here: the last step's plan and offsets are dropped before the next one's
 
 
 def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool) -> Iterator[Step]:
@@ -92,3 +93,4 @@ def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool) -> Iter
         yield Step(step, level, plan, faces, child, offsets, uv)
         corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
         level = child
+        del plan, uv_plan, faces, child, offsets, uv  # not held while the next step is planned

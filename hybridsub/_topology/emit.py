@@ -24,7 +24,8 @@ from .plan import EMPTY_FLOAT, StepPlan
 def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     """The next level (faces, twins, tags) and the parent face of each of its faces.
 
-    Without ``want_topology`` only the faces are built (for the last step of a call).
+    Without ``want_topology`` only the faces are built (for the last step of a call), and the
+    parents are not returned (None): nothing holds them while the data is refined.
     """
     m = level.n_faces
     face_sharp = level.face_sharp
@@ -47,7 +48,7 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
             level.twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, plan.hkind, plan.face_point,
             plan.trisected, face_sharp, first, twin, hsharp, child_sharp)
         child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
-    return faces, child, offsets
+    return faces, child, offsets if want_topology else None
 
 
 def face_parents(offsets: np.ndarray) -> np.ndarray:
