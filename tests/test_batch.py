@@ -359,6 +359,7 @@ def test_changed_option_deleted_output_changed_input(collection, reference, clus
 # faults
 
 
+@pytest.mark.slow  # subprocesses: ~4 s; .ci/run runs the slow tests
 def test_killed_worker_mid_batch(collection, reference, cluster, tmp_path, capfd, caplog):
     """SIGKILL to a worker process while it runs tasks: Dask runs them again elsewhere, every
     output is written once and whole, and none of Dask's warnings or tracebacks reach the user

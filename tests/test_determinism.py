@@ -81,6 +81,7 @@ def test_one_or_two_threads_identical_bits():
     assert all(got[t] == got[counts[0]] for t in counts)
 
 
+@pytest.mark.slow  # subprocesses: ~4 s; .ci/run runs the slow tests
 def test_process_to_process_identical_bits():
     # a fresh interpreter with another hash seed and one Numba thread gives the same bits
     code = ("import sys, json; sys.path.insert(0, 'tests'); import test_determinism as t; "
