@@ -209,6 +209,8 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
     rest = np.flatnonzero(~fast)
     if len(rest):
         keys0 = starts.of(f[rest])
+        by_key = np.argsort(keys0, kind="stable")  # points on one patch together: the tables they read stay cached
+        rest, keys0 = rest[by_key], keys0[by_key]
         args = _last_weights(table, keys0, b[rest], _corners(len(rest)), n_rows, depth, table.regular_stop)
         part = np.zeros((n_rows, len(rest), X.shape[1]))
         back_points(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
