@@ -305,7 +305,7 @@ def back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, b
     gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
     canonical vertex ``k`` is control vertex ``vids[base[q] + k]``; ``order[base[q]:]`` lists
     them by increasing id): the sums of the CSR product of ``walk.walk_rows``, term for term in
-    its order, so the same bits."""
+    its order (zeros left out, as there), so the same bits."""
     buf = _buffer(stop, keys, nv, W.shape[1])
     for q in range(len(stop)):
         s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
@@ -316,8 +316,9 @@ def back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, b
             col = vids[b + loc]
             for r in range(W.shape[1]):
                 a = buf[s, loc, r]
-                for d in range(X.shape[1]):
-                    res[r, q, d] += a * X[col, d]
+                if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
+                    for d in range(X.shape[1]):
+                        res[r, q, d] += a * X[col, d]
 
 
 @kernel
@@ -597,3 +598,53 @@ def regular_rings(F, twin, hsharp, face_sharp, corner, out):
         if ok and n == 12:
             for i in range(12):
                 out[f, i] = ring[i]
+
+
+@kernel(inline="always")
+def _ring_one(q, W, C, rings, perm, val):
+    """Point ``q`` on a regular face: ``perm`` (12,) the order of its control vertices by
+    increasing id, ``val`` (r, 12) its rows' values in that order (``W`` (q, r, 15) its
+    weights on the quartic's coefficients, ``C`` (15, 12) the coefficients over the face's
+    twelve control vertices ``rings`` (q, 12))."""
+    for i in range(12):  # insertion sort of the twelve ids
+        k = i
+        while k > 0 and rings[q, perm[k - 1]] > rings[q, i]:
+            perm[k] = perm[k - 1]
+            k -= 1
+        perm[k] = i
+    for i in range(12):
+        k = perm[i]
+        for r in range(W.shape[1]):
+            acc = 0.0
+            for j in range(15):
+                acc += W[q, r, j] * C[j, k]
+            val[r, i] = acc
+
+
+@kernel
+def ring_rows(W, C, rings, ids, vals):
+    """Rows of points on regular faces (:func:`_ring_one`): ``ids`` (q, 12) each point's
+    control vertices by increasing id, ``vals`` (r, q, 12) its rows' values there."""
+    perm = np.empty(12, np.int64)
+    val = np.empty((W.shape[1], 12))
+    for q in range(len(rings)):
+        _ring_one(q, W, C, rings, perm, val)
+        for i in range(12):
+            ids[q, i] = rings[q, perm[i]]
+            for r in range(W.shape[1]):
+                vals[r, q, i] = val[r, i]
+
+
+@kernel
+def ring_points(W, C, rings, X, res):
+    """:func:`ring_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
+    gets the sums of the CSR product of those rows, term for term in its order."""
+    perm = np.empty(12, np.int64)
+    val = np.empty((W.shape[1], 12))
+    for q in range(len(rings)):
+        _ring_one(q, W, C, rings, perm, val)
+        for i in range(12):
+            col = rings[q, perm[i]]
+            for r in range(W.shape[1]):
+                for d in range(X.shape[1]):
+                    res[r, q, d] += val[r, i] * X[col, d]

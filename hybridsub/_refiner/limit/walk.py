@@ -17,7 +17,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput, open_gate
-from ._cache_kernels import back_points, back_rows, regular_rings, stencil_points, walk_known
+from ._cache_kernels import (
+    back_points,
+    back_rows,
+    regular_rings,
+    ring_points,
+    ring_rows,
+    stencil_points,
+    walk_known,
+)
 from .cache import Grow, PatchTable
 from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
@@ -151,13 +159,13 @@ def _ring_rows(rings: np.ndarray, b: np.ndarray, n_rows: int, n: int) -> list:
     """The rows of points on regular input faces (their rings ``rings`` (q, 12)): the box
     spline's quartic (:func:`ring_coefficients`) at ``b``, as CSR matrices (q, n)."""
     q = len(rings)
-    R = polynomial_weights(b, _corners(q), n_rows) @ ring_coefficients()  # (q, n_rows, 12)
-    order = np.argsort(rings, axis=1)
-    cols = np.take_along_axis(rings, order, axis=1).ravel()
+    ids = np.empty((q, 12), np.int64)
+    vals = np.empty((n_rows, q, 12))
+    ring_rows(polynomial_weights(b, _corners(q), n_rows), ring_coefficients(), rings, ids, vals)
     indptr = np.arange(0, 12 * q + 1, 12)
     mats = []
     for r in range(n_rows):
-        M = sp.csr_matrix((np.take_along_axis(R[:, r], order, axis=1).ravel(), cols, indptr), shape=(q, n))
+        M = sp.csr_matrix((vals[r].ravel(), ids.ravel(), indptr), shape=(q, n))
         M.has_canonical_format = True
         mats.append(M)
     return mats
@@ -192,6 +200,7 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     for r in range(n_rows):
         M = sp.csr_matrix((out[row, loc, r], cols, indptr), shape=(q, n))
         M.has_canonical_format = True  # sorted, no duplicates: one patch's distinct vertices
+        M.eliminate_zeros()  # the vertices of the first patch a row does not reach
         mats.append(M)
     return mats
 
@@ -204,8 +213,10 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
     rings = starts.rings[f]
     fast = rings[:, 0] >= 0
     if fast.any():
-        for r, M in enumerate(_ring_rows(rings[fast], b[fast], n_rows, starts.inp.n_vertices)):
-            res[r, fast] = M @ X
+        part = np.zeros((n_rows, int(fast.sum()), X.shape[1]))
+        ring_points(polynomial_weights(b[fast], _corners(len(part[0])), n_rows), ring_coefficients(), rings[fast], X,
+                    part)
+        res[:, fast] = part
     rest = np.flatnonzero(~fast)
     if len(rest):
         keys0 = starts.of(f[rest])
