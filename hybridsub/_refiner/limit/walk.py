@@ -2,11 +2,13 @@
 
 Every point starts at the key of its input face's patch and, level by level, picks its child
 face among the key's candidates (as ``descent.step`` does), moving to the child's key; the
-candidates chosen are recorded. Keys met for the first time are refined (in one batch per
-level), so after the first calls a level is one small kernel over the points. At the end the
-last interpolation's weights times the limit rows of its six vertices give a row over the
-last patch, carried back through the recorded steps' rows to the first patch and onto the
-control vertices: the same products as ``LimitSurface``'s direct descent, in another order.
+candidates chosen are recorded. The walk runs in one kernel as far as the table knows the
+way; keys met for the first time are refined in a batch and the walk goes on. At the end the
+last interpolation's weights times the limit rows of its six vertices (or a regular patch's
+quartic) give a row over the last patch, carried back through the recorded steps' rows to the
+first patch and onto the control vertices: the same products as ``LimitSurface``'s direct
+descent, in another order. Points on regular input faces skip all this: the box spline of
+their twelve control vertices (:func:`ring_coefficients`).
 """
 
 from __future__ import annotations
