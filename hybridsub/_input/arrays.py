@@ -103,6 +103,12 @@ _TRIANGULATE = (
 )
 
 
+def writable(A: np.ndarray) -> np.ndarray:
+    """``A``, or a copy of it when it is read-only: Numba types a read-only array apart from a
+    writable one, so a read-only input would compile every kernel it reaches a second time."""
+    return A if A.flags.writeable else A.copy()
+
+
 def as_vertices(V, return_dtype: bool = False):
     """(n, 3) float64 C-contiguous copy-or-view of V (never written to).
 
@@ -118,7 +124,7 @@ def as_vertices(V, return_dtype: bool = False):
             A.ndim == 2 and A.shape[1] == 2) else ""
         raise MeshError(f"V must have shape (n, 3), got {A.shape}{hint}")
     dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.dtype(np.float64)
-    A = np.ascontiguousarray(A, dtype=np.float64)
+    A = writable(np.ascontiguousarray(A, dtype=np.float64))
     bad = ~np.isfinite(A).all(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -185,7 +191,7 @@ def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
             n_vertices = int(top) + 1
     elif n_vertices is None:
         n_vertices = 0
-    Fi = np.ascontiguousarray(A, dtype=np.int64)
+    Fi = writable(np.ascontiguousarray(A, dtype=np.int64))
     if Fi.size:
         rep = (Fi[:, 0] == Fi[:, 1]) | (Fi[:, 1] == Fi[:, 2]) | (Fi[:, 2] == Fi[:, 0])
         if rep.any():

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .._input import RefineInput, as_data, count_of, open_gate, tag_counts
+from .._input import RefineInput, as_data, count_of, open_gate, tag_counts, writable
 from .._topology import build_level, child_creases, face_parents
 from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .budget import Budget, check_product
@@ -204,7 +204,7 @@ class Refinement:
         """
         A, out_dtype, work = as_data(X, self.n_coarse)  # dtypes, shapes, never a view
         k = int(np.prod(A.shape[1:], dtype=np.int64))
-        Y = np.asarray(A, dtype=work).reshape(self.n_coarse, k)
+        Y = writable(np.asarray(A, dtype=work).reshape(self.n_coarse, k))
         if out is not None:
             dest = _output_buffer(out, (self.n_vertices,) + A.shape[1:], work)
             if not self.steps:

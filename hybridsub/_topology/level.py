@@ -101,7 +101,7 @@ class Level:
 
     def find_halfedges(self, pairs: np.ndarray) -> np.ndarray:
         """A halfedge of each vertex pair's edge, −1 where the mesh has no such edge."""
-        pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
+        pairs = np.array(pairs, dtype=np.int64, order="C").reshape(-1, 2)  # a writable copy: one kernel signature
         return K.find_halfedges(pairs, self.faces, self.by_origin, self.origin_start)
 
     def find_edges(self, pairs: np.ndarray) -> np.ndarray:

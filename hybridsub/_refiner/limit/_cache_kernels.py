@@ -638,7 +638,8 @@ def ring_rows(W, C, rings, ids, vals):
 @kernel
 def ring_points(W, C, rings, X, res):
     """:func:`ring_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
-    gets the sums of the CSR product of those rows, term for term in its order."""
+    gets the sums of the CSR product of those rows (zeros left out), term for term in its
+    order."""
     perm = np.empty(12, np.int64)
     val = np.empty((W.shape[1], 12))
     for q in range(len(rings)):
@@ -646,5 +647,6 @@ def ring_points(W, C, rings, X, res):
         for i in range(12):
             col = rings[q, perm[i]]
             for r in range(W.shape[1]):
-                for d in range(X.shape[1]):
-                    res[r, q, d] += val[r, i] * X[col, d]
+                if val[r, i] != 0.0:  # as walk._ring_rows, which leaves zeros out
+                    for d in range(X.shape[1]):
+                        res[r, q, d] += val[r, i] * X[col, d]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import as_vertices, open_gate
+from ..._input import as_vertices, open_gate, writable
 from ..._typing import ArrayLike, LoopWeights, Scheme
 from .cache import PatchTable
 from .project import closest_points, seed_setup
@@ -194,7 +194,7 @@ class LimitSurface:
         X = self._data(vertices)
         f, b = self._points(face, bary)
         n_rows = 3 if derivatives else 1
-        X2 = np.ascontiguousarray(X.reshape(len(X), -1))
+        X2 = writable(np.ascontiguousarray(X.reshape(len(X), -1)))
         parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
                                                               self.depth, X2))
         res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))

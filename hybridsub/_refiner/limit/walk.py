@@ -169,6 +169,7 @@ def _ring_rows(rings: np.ndarray, b: np.ndarray, n_rows: int, n: int) -> list:
     for r in range(n_rows):
         M = sp.csr_matrix((vals[r].ravel(), ids.ravel(), indptr), shape=(q, n))
         M.has_canonical_format = True
+        M.eliminate_zeros()  # e.g. at a vertex: only its own ring
         mats.append(M)
     return mats
 
