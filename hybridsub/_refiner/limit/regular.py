@@ -21,7 +21,7 @@ from math import factorial
 
 import numpy as np
 
-from ._cache_kernels import quartic_points
+from ._walk_kernels import quartic_points
 
 #: Exponents (i, j, k), i + j + k = 4, of the quartic Bernstein basis over (b0, b1, b2).
 EXPONENTS = np.array([(i, j, 4 - i - j) for i in range(4, -1, -1) for j in range(4 - i, -1, -1)])

@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput, open_gate
-from ._cache_kernels import (
+from ._walk_kernels import (
     back_points,
     back_rows,
     regular_rings,
@@ -53,7 +53,7 @@ class StartKeys:
     @property
     def rings(self) -> np.ndarray:
         """The twelve control vertices of each regular input face, −1 rows elsewhere
-        (:func:`._cache_kernels.regular_rings`; all −1 when the table does not stop at
+        (:func:`._walk_kernels.regular_rings`; all −1 when the table does not stop at
         regular patches)."""
         if self._rings is None:
             lvl, m = self.inp.level, self.inp.n_faces
@@ -108,7 +108,7 @@ def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool)
 
 def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
     """The walk down (:func:`_descend`) and each point's weights on its last patch: the
-    arguments of :func:`._cache_kernels.back_rows` before its output."""
+    arguments of :func:`._walk_kernels.back_rows` before its output."""
     q = len(keys0)
     keys, path, stop, bary, uv = _descend(table, keys0, bary.copy(), uv.copy(), depth, stop_regular)
     last = keys[np.arange(q), stop]
@@ -235,7 +235,7 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
 @functools.cache
 def ring_coefficients() -> np.ndarray:
     """The quartic's 15 Bernstein coefficients (:mod:`.regular`) over the twelve control
-    vertices of a regular face, in the order of :func:`._cache_kernels.regular_rings`: the
+    vertices of a regular face, in the order of :func:`._walk_kernels.regular_rings`: the
     walk's own quartic on a face of a regular torus (the same for every regular face; Loop's
     and Warren's weights agree at valence 6), rounded to the 24ths they are."""
     V, F = regular_torus()

@@ -1,0 +1,433 @@
+"""Numba kernels of the walk through the patch cache (:mod:`.walk`): the child choice, the
+rows carried back (onto the control vertices, or applied to the data), the last
+interpolation, regular patches' quartics and regular input faces.
+
+Private. Contiguous arrays in, outputs allocated by the caller.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._jit import kernel
+
+
+#: Candidates whose smallest barycentric coordinates differ by less are a tie.
+TIE = 1e-14
+
+
+@kernel(inline="always")
+def _pick_one(q, k, bary, uv, cand_start, cand_count, M, b):
+    """Point ``q``'s child face among key ``k``'s candidates (the largest smallest barycentric
+    coordinate; the first of those equal to ``TIE``, so a point on an edge stays on the
+    centre face's side): its coordinates there and the child's corners in (u, v) replace
+    ``bary[q]`` and ``uv[q]``. ``M`` (c, 3, 3) takes a point's barycentric coordinates into
+    each candidate's; its inverse transposed holds the candidate's corners over the face.
+    Returns the candidate."""
+    s = cand_start[k]
+    best = -np.inf
+    chosen = -1
+    nb0 = nb1 = nb2 = 0.0
+    for j in range(s, s + cand_count[k]):
+        lo = np.inf
+        for i in range(3):
+            b[i] = M[j, i, 0] * bary[q, 0] + M[j, i, 1] * bary[q, 1] + M[j, i, 2] * bary[q, 2]
+            lo = min(lo, b[i])
+        if lo > best + TIE:
+            best = lo
+            chosen = j
+            nb0, nb1, nb2 = b[0], b[1], b[2]
+    j = chosen
+    bary[q, 0], bary[q, 1], bary[q, 2] = nb0, nb1, nb2
+    # G = (Mᵀ)⁻¹: the cofactors of M over its determinant.
+    det = (M[j, 0, 0] * (M[j, 1, 1] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 1])
+           - M[j, 0, 1] * (M[j, 1, 0] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 0])
+           + M[j, 0, 2] * (M[j, 1, 0] * M[j, 2, 1] - M[j, 1, 1] * M[j, 2, 0]))
+    for d in range(2):
+        u0, u1, u2 = uv[q, 0, d], uv[q, 1, d], uv[q, 2, d]
+        for a in range(3):
+            a1, a2 = (a + 1) % 3, (a + 2) % 3
+            g0 = (M[j, a1, 1] * M[j, a2, 2] - M[j, a1, 2] * M[j, a2, 1]) / det
+            g1 = (M[j, a1, 2] * M[j, a2, 0] - M[j, a1, 0] * M[j, a2, 2]) / det
+            g2 = (M[j, a1, 0] * M[j, a2, 1] - M[j, a1, 1] * M[j, a2, 0]) / det
+            b[a] = g0 * u0 + g1 * u1 + g2 * u2
+        for a in range(3):
+            uv[q, a, d] = b[a]
+    return j
+
+
+@kernel
+def walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_count, M, child, regular,
+               stop_regular, depth):
+    """The walk (``walk._descend``) of the points ``todo`` as far as the table knows the way.
+
+    Point ``q`` is at ``level[q]`` on key ``keys[q, level[q]]`` (``state[q]`` 1: it has
+    chosen ``path[q, level[q]]`` there, whose child patch was not cut yet). It goes down,
+    choosing a child per level (``_pick_one``), to ``depth`` or (with ``stop_regular``) to
+    the first regular key, and then ``stop[q]`` is set and ``state[q]`` 0; or it halts at a
+    key whose candidates are not known (``state[q]`` 2) or at a candidate whose child patch is
+    not cut (``state[q]`` 1) for the caller to fill the table and call again."""
+    b = np.empty(3)
+    for i in range(len(todo)):
+        q = todo[i]
+        lev = level[q]
+        if state[q] == 1:
+            keys[q, lev + 1] = child[path[q, lev]]
+            lev += 1
+        state[q] = 0
+        while True:
+            k = keys[q, lev]
+            if (stop_regular and regular[k] == 1) or lev == depth:
+                stop[q] = lev
+                break
+            if cand_start[k] < 0:
+                state[q] = 2
+                break
+            j = _pick_one(q, k, bary, uv, cand_start, cand_count, M, b)
+            path[q, lev] = j
+            if child[j] < 0:
+                state[q] = 1
+                break
+            keys[q, lev + 1] = child[j]
+            lev += 1
+        level[q] = lev
+
+
+@kernel(inline="always")
+def _back_any(buf, s, t, e, end, t_row, t_col, t_val):
+    """``buf[t] += T^T buf[s]`` over the entries ``e:end`` of one transition, by rows: rows
+    whose sums are all zero are skipped."""
+    nr = buf.shape[2]
+    while e < end:
+        a = t_row[e]
+        live = False
+        for r in range(nr):
+            if buf[s, a, r] != 0.0:
+                live = True
+        if live:
+            while e < end and t_row[e] == a:
+                x = t_val[e]
+                b = t_col[e]
+                for r in range(nr):
+                    buf[t, b, r] += buf[s, a, r] * x
+                e += 1
+        else:
+            while e < end and t_row[e] == a:
+                e += 1
+
+
+@kernel(inline="always")
+def _back3(buf, s, t, e, end, t_row, t_col, t_val):
+    """:func:`_back_any` for three rows (value, ∂/∂u, ∂/∂v) held in registers: the same sums."""
+    while e < end:
+        a = t_row[e]
+        r0 = buf[s, a, 0]
+        r1 = buf[s, a, 1]
+        r2 = buf[s, a, 2]
+        if r0 != 0.0 or r1 != 0.0 or r2 != 0.0:
+            while e < end and t_row[e] == a:
+                x = t_val[e]
+                b = t_col[e]
+                buf[t, b, 0] += r0 * x
+                buf[t, b, 1] += r1 * x
+                buf[t, b, 2] += r2 * x
+                e += 1
+        else:
+            while e < end and t_row[e] == a:
+                e += 1
+
+
+@kernel(inline="always")
+def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
+              t_row, t_col, t_val):
+    """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``."""
+    nr = W.shape[1]
+    d = stop[q]
+    s = 0
+    ns = slots[q]
+    for v in range(nv[keys[q, d]]):
+        for r in range(nr):
+            buf[0, v, r] = 0.0
+    b = block[q]
+    for k in range(blk_nc[b]):
+        v = blk_col[blk_c0[b] + k]
+        off = blk_v0[b] + k * ns
+        for r in range(nr):
+            acc = 0.0
+            for j in range(ns):
+                acc += W[q, r, j] * blk_val[off + j]
+            buf[0, v, r] = acc
+    for lev in range(d - 1, -1, -1):
+        c = path[q, lev]
+        t = 1 - s
+        for v in range(nv[keys[q, lev]]):
+            for r in range(nr):
+                buf[t, v, r] = 0.0
+        e = t_start[c]
+        end = t_end[c]
+        if nr == 3:
+            _back3(buf, s, t, e, end, t_row, t_col, t_val)
+        else:
+            _back_any(buf, s, t, e, end, t_row, t_col, t_val)
+        s = t
+    return s
+
+
+@kernel(inline="always")
+def _buffer(stop, keys, nv, nr):
+    """Room for the largest patch the points meet: this level's rows and the next's."""
+    nmax = 0
+    for q in range(len(stop)):
+        for lev in range(stop[q] + 1):
+            nmax = max(nmax, nv[keys[q, lev]])
+    return np.zeros((2, nmax, nr))
+
+
+@kernel
+def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
+              t_col, t_val, out):
+    """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
+    last patch's ``slots`` (q,) rows (stencil vertices' limit rows, or a quartic's
+    coefficients) in the table's block ``block`` (q,) (``cache.PatchTable``'s ``blk_*``), then
+    back through the steps.
+
+    ``stop`` (q,) the level each point stopped at, ``path`` (q, d) the candidates chosen,
+    ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
+    """
+    buf = _buffer(stop, keys, nv, W.shape[1])
+    for q in range(len(stop)):
+        s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                      t_end, t_row, t_col, t_val)
+        for v in range(nv[keys[q, 0]]):
+            for r in range(W.shape[1]):
+                out[q, v, r] = buf[s, v, r]
+
+
+@kernel
+def back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
+                t_col, t_val, base, order, vids, X, res):
+    """:func:`back_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
+    gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
+    canonical vertex ``k`` is control vertex ``vids[base[q] + k]``; ``order[base[q]:]`` lists
+    them by increasing id): the sums of the CSR product of ``walk.walk_rows``, term for term in
+    its order (zeros left out, as there), so the same bits."""
+    buf = _buffer(stop, keys, nv, W.shape[1])
+    for q in range(len(stop)):
+        s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                      t_end, t_row, t_col, t_val)
+        b = base[q]
+        for k in range(nv[keys[q, 0]]):
+            loc = order[b + k]
+            col = vids[b + loc]
+            for r in range(W.shape[1]):
+                a = buf[s, loc, r]
+                if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
+                    for d in range(X.shape[1]):
+                        res[r, q, d] += a * X[col, d]
+
+
+@kernel
+def stencil_points(rec, bary, uv, inv, full, node, W):
+    """``descent.stencil_weights`` per point from a stencil record ``rec``: ``inv`` (s, 6, 6)
+    the inverse of each record's interpolation matrix, ``full`` whether it is used (else
+    linear), ``node`` (s, 9) the face's centroid (2), size (1) and corners (6). Fills ``W``
+    (q, r, 6): value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v², the first r of them."""
+    nr = W.shape[1]
+    rhs = np.empty((6, 6))
+    w = np.empty((6, 6))
+    J = np.empty((2, 2))
+    for q in range(len(rec)):
+        k = rec[q]
+        sc = node[k, 2]
+        xs = (bary[q, 0] * node[k, 3] + bary[q, 1] * node[k, 5] + bary[q, 2] * node[k, 7] - node[k, 0]) / sc
+        xt = (bary[q, 0] * node[k, 4] + bary[q, 1] * node[k, 6] + bary[q, 2] * node[k, 8] - node[k, 1]) / sc
+        e1s, e1t = node[k, 5] / sc - node[k, 3] / sc, node[k, 6] / sc - node[k, 4] / sc
+        e2s, e2t = node[k, 7] / sc - node[k, 3] / sc, node[k, 8] / sc - node[k, 4] / sc
+        w[:] = 0.0
+        if full[k]:
+            rhs[:] = 0.0
+            rhs[0, 0], rhs[1, 0], rhs[2, 0], rhs[3, 0], rhs[4, 0], rhs[5, 0] = 1.0, xs, xt, xs * xs, xs * xt, xt * xt
+            rhs[1, 1], rhs[3, 1], rhs[4, 1] = 1.0, 2 * xs, xt
+            rhs[2, 2], rhs[4, 2], rhs[5, 2] = 1.0, xs, 2 * xt
+            rhs[3, 3], rhs[4, 4], rhs[5, 5] = 2.0, 1.0, 2.0
+            for i in range(6):  # w = A⁻ᵀ rhs
+                for c in range(6):
+                    acc = 0.0
+                    for j in range(6):
+                        acc += inv[k, j, i] * rhs[j, c]
+                    w[i, c] = acc
+        else:  # linear: rows of the inverse of (e1 e2) are d bary1,2 / d(s, t)
+            det = e1s * e2t - e2s * e1t
+            w[0, 0], w[1, 0], w[2, 0] = bary[q, 0], bary[q, 1], bary[q, 2]
+            w[1, 1], w[1, 2] = e2t / det, -e2s / det
+            w[2, 1], w[2, 2] = -e1t / det, e1s / det
+            w[0, 1], w[0, 2] = -(w[1, 1] + w[2, 1]), -(w[1, 2] + w[2, 2])
+        top = 0
+        for c in range(1, 3):
+            if bary[q, c] > bary[q, top]:
+                top = c
+        if bary[q, top] >= 1.0 - 1e-14:  # at a vertex: its limit position exactly
+            for i in range(6):
+                w[i, 0] = 0.0
+            w[top, 0] = 1.0
+        # J = ∂(s,t)/∂(u,v) = (e1 e2) (uv1 − uv0, uv2 − uv0)⁻¹
+        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
+        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
+        dt = a * d_ - b * c_
+        i00, i01, i10, i11 = d_ / dt, -b / dt, -c_ / dt, a / dt
+        J[0, 0], J[0, 1] = e1s * i00 + e2s * i10, e1s * i01 + e2s * i11
+        J[1, 0], J[1, 1] = e1t * i00 + e2t * i10, e1t * i01 + e2t * i11
+        for i in range(6):
+            W[q, 0, i] = w[i, 0]
+            if nr > 1:
+                W[q, 1, i] = w[i, 1] * J[0, 0] + w[i, 2] * J[1, 0]
+                W[q, 2, i] = w[i, 1] * J[0, 1] + w[i, 2] * J[1, 1]
+            if nr > 3:
+                for o, (r1, r2) in enumerate(((0, 0), (0, 1), (1, 1))):
+                    acc = 0.0
+                    for p in range(2):
+                        for s in range(2):
+                            acc += J[p, r1] * w[i, 3 + p + s] * J[s, r2]
+                    W[q, 3 + o, i] = acc
+
+
+@kernel
+def quartic_points(bary, uv, exps, coef, W):
+    """``regular.polynomial_weights``: the quartic Bernstein basis ``coef`` · b^``exps`` (15)
+    at every point and its derivatives in (u, v) (``uv`` (q, 3, 2) the face's corners), into
+    ``W`` (q, r, 15): value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v², the first r of them."""
+    nr = W.shape[1]
+    pw = np.zeros((3, 7))  # pw[c, p + 2] = b_c ** p, zero for p < 0
+    G = np.empty((2, 2))
+    for q in range(len(bary)):
+        for c in range(3):
+            pw[c, 2] = 1.0
+            for p in range(1, 5):
+                pw[c, p + 2] = pw[c, p + 1] * bary[q, c]
+        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
+        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
+        dt = a * d_ - b * c_
+        G[0, 0], G[0, 1], G[1, 0], G[1, 1] = d_ / dt, -b / dt, -c_ / dt, a / dt  # ∂(b1, b2)/∂(u, v)
+        for t in range(15):
+            i, j, k = exps[t, 0], exps[t, 1], exps[t, 2]
+            f = coef[t]
+            W[q, 0, t] = f * pw[0, i + 2] * pw[1, j + 2] * pw[2, k + 2]
+            if nr == 1:
+                continue
+            d1 = f * (j * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 2] - i * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 2])
+            d2 = f * (k * pw[0, i + 2] * pw[1, j + 2] * pw[2, k + 1] - i * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 2])
+            W[q, 1, t] = d1 * G[0, 0] + d2 * G[1, 0]
+            W[q, 2, t] = d1 * G[0, 1] + d2 * G[1, 1]
+            if nr == 3:
+                continue
+            t00 = i * (i - 1) * pw[0, i] * pw[1, j + 2] * pw[2, k + 2]
+            h11 = f * (j * (j - 1) * pw[0, i + 2] * pw[1, j] * pw[2, k + 2]
+                       - 2 * i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
+            h12 = f * (j * k * pw[0, i + 2] * pw[1, j + 1] * pw[2, k + 1]
+                       - i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1]
+                       - i * j * pw[0, i + 1] * pw[1, j + 1] * pw[2, k + 2] + t00)
+            h22 = f * (k * (k - 1) * pw[0, i + 2] * pw[1, j + 2] * pw[2, k]
+                       - 2 * i * k * pw[0, i + 1] * pw[1, j + 2] * pw[2, k + 1] + t00)
+            for o in range(3):
+                r1, r2 = (0, 0) if o == 0 else ((0, 1) if o == 1 else (1, 1))
+                W[q, 3 + o, t] = (G[0, r1] * h11 * G[0, r2] + G[0, r1] * h12 * G[1, r2]
+                                  + G[1, r1] * h12 * G[0, r2] + G[1, r1] * h22 * G[1, r2])
+
+
+@kernel
+def regular_rings(F, twin, hsharp, face_sharp, corner, out):
+    """The twelve control vertices of every regular face (``regular.is_regular`` at level 0,
+    interior: each corner untagged with six Loop faces and no crease): its corners, then
+    each corner's other neighbours going round it (across the edge coming in to it) from the
+    face, each vertex once. ``out`` (m, 12) gets them, −1 rows for the other faces."""
+    ring = np.empty(12, np.int64)
+    for f in range(len(F)):
+        out[f, :] = -1
+        n = 3
+        for c in range(3):
+            ring[c] = F[f, c]
+        ok = face_sharp[f]
+        for c in range(3):
+            v = F[f, c]
+            if corner[v]:
+                ok = False
+            g, cc = f, c
+            faces = 0
+            while ok:
+                w = F[g, (cc + 1) % 3]
+                seen = False
+                for i in range(n):
+                    if ring[i] == w:
+                        seen = True
+                if not seen:
+                    if n == 12:
+                        ok = False
+                        break
+                    ring[n] = w
+                    n += 1
+                h_in = 3 * g + (cc + 2) % 3
+                t = twin[h_in]
+                if t < 0 or hsharp[h_in] != 0.0 or hsharp[3 * g + cc] != 0.0 or not face_sharp[g]:
+                    ok = False
+                    break
+                g, cc = t // 3, t % 3
+                faces += 1
+                if g == f or faces > 6:
+                    break
+            if faces != 6 or g != f:
+                ok = False
+        if ok and n == 12:
+            for i in range(12):
+                out[f, i] = ring[i]
+
+
+@kernel(inline="always")
+def _ring_one(q, W, C, rings, perm, val):
+    """Point ``q`` on a regular face: ``perm`` (12,) the order of its control vertices by
+    increasing id, ``val`` (r, 12) its rows' values in that order (``W`` (q, r, 15) its
+    weights on the quartic's coefficients, ``C`` (15, 12) the coefficients over the face's
+    twelve control vertices ``rings`` (q, 12))."""
+    for i in range(12):  # insertion sort of the twelve ids
+        k = i
+        while k > 0 and rings[q, perm[k - 1]] > rings[q, i]:
+            perm[k] = perm[k - 1]
+            k -= 1
+        perm[k] = i
+    for i in range(12):
+        k = perm[i]
+        for r in range(W.shape[1]):
+            acc = 0.0
+            for j in range(15):
+                acc += W[q, r, j] * C[j, k]
+            val[r, i] = acc
+
+
+@kernel
+def ring_rows(W, C, rings, ids, vals):
+    """Rows of points on regular faces (:func:`_ring_one`): ``ids`` (q, 12) each point's
+    control vertices by increasing id, ``vals`` (r, q, 12) its rows' values there."""
+    perm = np.empty(12, np.int64)
+    val = np.empty((W.shape[1], 12))
+    for q in range(len(rings)):
+        _ring_one(q, W, C, rings, perm, val)
+        for i in range(12):
+            ids[q, i] = rings[q, perm[i]]
+            for r in range(W.shape[1]):
+                vals[r, q, i] = val[r, i]
+
+
+@kernel
+def ring_points(W, C, rings, X, res):
+    """:func:`ring_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
+    gets the sums of the CSR product of those rows (zeros left out), term for term in its
+    order."""
+    perm = np.empty(12, np.int64)
+    val = np.empty((W.shape[1], 12))
+    for q in range(len(rings)):
+        _ring_one(q, W, C, rings, perm, val)
+        for i in range(12):
+            col = rings[q, perm[i]]
+            for r in range(W.shape[1]):
+                if val[r, i] != 0.0:  # as walk._ring_rows, which leaves zeros out
+                    for d in range(X.shape[1]):
+                        res[r, q, d] += val[r, i] * X[col, d]
