@@ -246,3 +246,23 @@ def test_evaluate_in_chunks_equals_the_matrix_bit_for_bit(mesh, monkeypatch):
     assert np.array_equal(s.evaluate(face, bary, vertices=h), mats[0] @ h)
     P0, Du0, Dv0 = s.evaluate(face[:0], bary[:0], derivatives=True)
     assert P0.shape == (0, 3) and Du0.shape == (0, 3) and s.evaluation_matrix(face[:0], bary[:0]).shape == (0, len(V))
+
+
+@pytest.mark.slow  # compiles the threaded twins of the walk's kernels: ~13 s on an empty cache
+@pytest.mark.parametrize("mesh", ["torus-crease", "hybrid-crease"])
+def test_threaded_walk_gives_the_serial_bits(mesh, monkeypatch):
+    """walk_known and back_points on threads (tasks of points) == their serial twins, bit for
+    bit, values and derivatives, on a fresh surface each (the table filled the same way)."""
+    import hybridsub._topology._kernels as topo
+
+    if mesh == "hybrid-crease":
+        V, F, kw = CASES[mesh]
+    else:
+        (V, F), kw = _regular_meshes(mesh)
+    face, bary = _points(F, 300, seed=13)
+    got = {}
+    for threaded in (False, True):
+        monkeypatch.setattr(topo, "PARALLEL_MIN", 0 if threaded else 10**12)
+        got[threaded] = hybridsub.LimitSurface(V, F, **kw).evaluate(face, bary, derivatives=True)
+    for a, b in zip(got[False], got[True]):
+        assert np.array_equal(a, b)

@@ -8,12 +8,15 @@ Private. Contiguous arrays in, outputs allocated by the caller.
 from __future__ import annotations
 
 import numpy as np
+from numba import prange
 
-from ..._jit import kernel
+from ..._jit import kernel, threaded_and_serial
 
 
 #: Candidates whose smallest barycentric coordinates differ by less are a tie.
 TIE = 1e-14
+#: Points per task of the threaded kernels (each point is independent of the others).
+TASK = 64
 
 
 @kernel(inline="always")
@@ -56,9 +59,8 @@ def _pick_one(q, k, bary, uv, cand_start, cand_count, M, b):
     return j
 
 
-@kernel
-def walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_count, M, child, regular,
-               stop_regular, depth):
+def _walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_count, M, child, regular,
+                stop_regular, depth):
     """The walk (``walk._descend``) of the points ``todo`` as far as the table knows the way.
 
     Point ``q`` is at ``level[q]`` on key ``keys[q, level[q]]`` (``state[q]`` 1: it has
@@ -66,31 +68,36 @@ def walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_
     choosing a child per level (``_pick_one``), to ``depth`` or (with ``stop_regular``) to
     the first regular key, and then ``stop[q]`` is set and ``state[q]`` 0; or it halts at a
     key whose candidates are not known (``state[q]`` 2) or at a candidate whose child patch is
-    not cut (``state[q]`` 1) for the caller to fill the table and call again."""
-    b = np.empty(3)
-    for i in range(len(todo)):
-        q = todo[i]
-        lev = level[q]
-        if state[q] == 1:
-            keys[q, lev + 1] = child[path[q, lev]]
-            lev += 1
-        state[q] = 0
-        while True:
-            k = keys[q, lev]
-            if (stop_regular and regular[k] == 1) or lev == depth:
-                stop[q] = lev
-                break
-            if cand_start[k] < 0:
-                state[q] = 2
-                break
-            j = _pick_one(q, k, bary, uv, cand_start, cand_count, M, b)
-            path[q, lev] = j
-            if child[j] < 0:
-                state[q] = 1
-                break
-            keys[q, lev + 1] = child[j]
-            lev += 1
-        level[q] = lev
+    not cut (``state[q]`` 1) for the caller to fill the table and call again. Threaded over
+    tasks of points (``walk_known``; ``walk_known_serial`` the same on one thread)."""
+    for task in prange((len(todo) + TASK - 1) // TASK):
+        b = np.empty(3)
+        for i in range(task * TASK, min(len(todo), (task + 1) * TASK)):
+            q = todo[i]
+            lev = level[q]
+            if state[q] == 1:
+                keys[q, lev + 1] = child[path[q, lev]]
+                lev += 1
+            state[q] = 0
+            while True:
+                k = keys[q, lev]
+                if (stop_regular and regular[k] == 1) or lev == depth:
+                    stop[q] = lev
+                    break
+                if cand_start[k] < 0:
+                    state[q] = 2
+                    break
+                j = _pick_one(q, k, bary, uv, cand_start, cand_count, M, b)
+                path[q, lev] = j
+                if child[j] < 0:
+                    state[q] = 1
+                    break
+                keys[q, lev + 1] = child[j]
+                lev += 1
+            level[q] = lev
+
+
+walk_known, walk_known_serial = threaded_and_serial(_walk_known)
 
 
 @kernel(inline="always")
@@ -174,13 +181,13 @@ def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk
 
 
 @kernel(inline="always")
-def _buffer(stop, keys, nv, nr):
-    """Room for the largest patch the points meet: this level's rows and the next's."""
+def _largest(stop, keys, nv):
+    """The largest patch the points meet (vertices): the room a point's rows need."""
     nmax = 0
     for q in range(len(stop)):
         for lev in range(stop[q] + 1):
             nmax = max(nmax, nv[keys[q, lev]])
-    return np.zeros((2, nmax, nr))
+    return nmax
 
 
 @kernel
@@ -194,7 +201,7 @@ def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk
     ``stop`` (q,) the level each point stopped at, ``path`` (q, d) the candidates chosen,
     ``keys`` (q, d + 1) the keys met; ``out`` (q, nv_max, r) zeroed by the caller.
     """
-    buf = _buffer(stop, keys, nv, W.shape[1])
+    buf = np.zeros((2, _largest(stop, keys, nv), W.shape[1]))  # this level's rows and the next's
     for q in range(len(stop)):
         s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
                       t_end, t_row, t_col, t_val)
@@ -203,27 +210,32 @@ def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk
                 out[q, v, r] = buf[s, v, r]
 
 
-@kernel
-def back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
-                t_col, t_val, base, order, vids, X, res):
+def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
+                 t_row, t_col, t_val, base, order, vids, X, res):
     """:func:`back_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
     gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
     canonical vertex ``k`` is control vertex ``vids[base[q] + k]``; ``order[base[q]:]`` lists
     them by increasing id): the sums of the CSR product of ``walk.walk_rows``, term for term in
-    its order (zeros left out, as there), so the same bits."""
-    buf = _buffer(stop, keys, nv, W.shape[1])
-    for q in range(len(stop)):
-        s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
-                      t_end, t_row, t_col, t_val)
-        b = base[q]
-        for k in range(nv[keys[q, 0]]):
-            loc = order[b + k]
-            col = vids[b + loc]
-            for r in range(W.shape[1]):
-                a = buf[s, loc, r]
-                if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
-                    for d in range(X.shape[1]):
-                        res[r, q, d] += a * X[col, d]
+    its order (zeros left out, as there), so the same bits. Threaded over tasks of points
+    (``back_points``; ``back_points_serial`` the same on one thread)."""
+    nmax = _largest(stop, keys, nv)
+    for task in prange((len(stop) + TASK - 1) // TASK):
+        buf = np.zeros((2, nmax, W.shape[1]))  # this level's rows and the next's
+        for q in range(task * TASK, min(len(stop), (task + 1) * TASK)):
+            s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
+                          t_start, t_end, t_row, t_col, t_val)
+            b = base[q]
+            for k in range(nv[keys[q, 0]]):
+                loc = order[b + k]
+                col = vids[b + loc]
+                for r in range(W.shape[1]):
+                    a = buf[s, loc, r]
+                    if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
+                        for d in range(X.shape[1]):
+                            res[r, q, d] += a * X[col, d]
+
+
+back_points, back_points_serial = threaded_and_serial(_back_points)
 
 
 @kernel

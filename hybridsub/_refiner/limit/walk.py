@@ -19,15 +19,22 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._input import RefineInput, open_gate
+from ..._topology import use_threads
 from ._walk_kernels import (
     back_points,
+    back_points_serial,
     back_rows,
     regular_rings,
     ring_points,
     ring_rows,
     stencil_points,
     walk_known,
+    walk_known_serial,
 )
+
+#: A point of the walk costs about what this many faces of a refinement step do (the
+#: threshold of the threaded kernels, ``_topology.use_threads``, counts faces).
+POINT_COST = 20
 from .cache import Grow, PatchTable
 from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
@@ -94,8 +101,9 @@ def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool)
     state = np.zeros(q, np.int8)
     todo = np.arange(q)
     while len(todo):
-        walk_known(todo, level, state, keys, path, stop, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a,
-                   table.child.a, table.regular.a, stop_regular, depth)
+        kernel = walk_known if use_threads(POINT_COST * len(todo)) else walk_known_serial
+        kernel(todo, level, state, keys, path, stop, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a,
+               table.child.a, table.regular.a, stop_regular, depth)
         todo = todo[state[todo] != 0]
         steps = todo[state[todo] == 2]
         if len(steps):
@@ -227,7 +235,8 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         rest, keys0 = rest[by_key], keys0[by_key]
         args = _last_weights(table, keys0, b[rest], _corners(len(rest)), n_rows, depth, table.regular_stop)
         part = np.zeros((n_rows, len(rest), X.shape[1]))
-        back_points(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
+        kernel = back_points if use_threads(POINT_COST * len(rest)) else back_points_serial
+        kernel(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
         res[:, rest] = part
     return res
 
