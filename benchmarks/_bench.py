@@ -193,3 +193,13 @@ def run_warm(benchmark, fn, *, prepare=None, budget: float = 2.0, min_rounds: in
         box.clear()
 
     benchmark.pedantic(target, setup=setup, teardown=teardown, rounds=rounds, iterations=1, warmup_rounds=0)
+
+
+def frame_3d(ax, P, title: str, azim: float = -60):
+    """A figure panel's 3-D axes fitted to the points ``P``, seen from ``azim``, untitled axes."""
+    lo, hi = P.min(0), P.max(0)
+    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(hi - lo)
+    ax.view_init(25, azim)
+    ax.set_axis_off()
+    ax.set_title(title, fontsize=9)

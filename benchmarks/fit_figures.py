@@ -20,6 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
 from test_fit import CREASES, EDGE, FC, VC, _sample  # noqa: E402
 from conftest import load_mesh  # noqa: E402
+from _bench import frame_3d  # noqa: E402
 
 OUT = os.path.join(HERE, "..", "docs", "images")
 
@@ -67,16 +68,7 @@ def _error_map(ax, P, faces, pts, fp, diag, vmax, title):
     cmap = plt.get_cmap("viridis")
     poly = Poly3DCollection(P[faces], facecolors=cmap(np.clip(err / diag / vmax, 0, 1)), linewidths=0)
     ax.add_collection3d(poly)
-    _frame(ax, P, title)
-
-
-def _frame(ax, P, title):
-    lo, hi = P.min(0), P.max(0)
-    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(hi - lo)
-    ax.view_init(25, -60)
-    ax.set_axis_off()
-    ax.set_title(title, fontsize=9)
+    frame_3d(ax, P, title)
 
 
 def scan_fit():
@@ -107,14 +99,14 @@ def scan_fit():
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     few = pts[rng.choice(len(pts), 40_000, replace=False)]
     ax.scatter(few[:, 0], few[:, 1], few[:, 2], s=0.05, c="0.3", depthshade=False)
-    _frame(ax, V, "the scan: 500,000 points on fandisk's facets,\nnoise σ = 2e-4 × diagonal (4e4 drawn)")
+    frame_3d(ax, V, "the scan: 500,000 points on fandisk's facets,\nnoise σ = 2e-4 × diagonal (4e4 drawn)")
     ax = fig.add_subplot(2, 2, 2, projection="3d")
     ax.computed_zorder = False  # the creases over the faces
     ax.add_collection3d(Poly3DCollection(res.vertices[FC0], facecolors="0.88", edgecolors="0.45", linewidths=0.15,
                                          zorder=1))
     crease = np.asarray(feat.sharp_edges).reshape(-1, 2)
     ax.add_collection3d(Line3DCollection(res.vertices[crease], colors="crimson", linewidths=0.9, zorder=2))
-    _frame(ax, V, f"the fitted control mesh ({len(FC0):,} faces, decimated),\nits creases in red")
+    frame_3d(ax, V, f"the fitted control mesh ({len(FC0):,} faces, decimated),\nits creases in red")
     _error_map(fig.add_subplot(2, 2, 3, projection="3d"), before, r.faces, pts, fb, diag, vmax,
                f"before: the decimated mesh's own surface,\nRMS {np.sqrt(np.mean(fb.distance ** 2)) / diag:.1e} × diagonal")
     _error_map(fig.add_subplot(2, 2, 4, projection="3d"), after, r.faces, pts, fa, diag, vmax,

@@ -33,6 +33,7 @@ import hybridsub  # noqa: E402
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from limit_surface import bfr  # noqa: E402
+from _bench import frame_3d  # noqa: E402
 
 OUT = HERE.parent / "docs" / "images"
 
@@ -100,26 +101,17 @@ def main():
     ax.add_collection3d(Poly3DCollection(P[tris], facecolors=plt.cm.gray(shade), linewidths=0, zorder=1))
     segs = np.concatenate([C[:, :-1, None], C[:, 1:, None]], axis=2).reshape(-1, 2, 3)
     ax.add_collection3d(Line3DCollection(segs, colors="crimson", linewidths=0.8, zorder=2))
-    _frame(ax, P, f"Loop limit surface, {len(face):,} grid points,\ncrease curves in red")
+    frame_3d(ax, P, f"Loop limit surface, {len(face):,} grid points,\ncrease curves in red", azim=-55)
     ax = fig.add_subplot(1, 2, 2, projection="3d")
     e = np.maximum(err[tris].max(axis=1), 1e-15)
     norm = LogNorm(1e-15, max(float(e.max()), 1e-14))
     ax.add_collection3d(Poly3DCollection(P[tris], facecolors=plt.cm.magma(norm(e)), linewidths=0))
-    _frame(ax, P, f"|Bfr (default levels) − exact| / diagonal:\nmax {err.max():.1e}; exact (≤ 1e-15) on "
-                  f"{(err <= 1e-15).mean():.0%} of the points")
+    frame_3d(ax, P, f"|Bfr (default levels) − exact| / diagonal:\nmax {err.max():.1e}; exact (≤ 1e-15) on "
+                    f"{(err <= 1e-15).mean():.0%} of the points", azim=-55)
     fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap="magma"), ax=ax, shrink=0.6)
     fig.tight_layout()
     os.makedirs(OUT, exist_ok=True)
     fig.savefig(OUT / "limit_bfr.png", dpi=110)
-
-
-def _frame(ax, P, title):
-    lo, hi = P.min(0), P.max(0)
-    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(hi - lo)
-    ax.view_init(25, -55)
-    ax.set_axis_off()
-    ax.set_title(title, fontsize=9)
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
 
 import hybridsub
 from hybridsub._refiner.limit.descent import direct_rows
-from hybridsub._refiner.limit.regular import is_regular
+from hybridsub._refiner.limit.regular import is_regular, regular_torus
 
 
 def _points(F, k, seed=0):
@@ -90,17 +90,8 @@ def test_keys_repeat_in_regular_regions():
 
 def _torus(n=6, seed=6):
     """A closed n × n torus grid, every vertex of valence 6 (regular Loop everywhere), jittered."""
-    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
-    a, b = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / n
-    V = np.stack([(2 + np.cos(b)) * np.cos(a), (2 + np.cos(b)) * np.sin(a), np.sin(b)], 1)
-    V += 0.05 * np.random.default_rng(seed).standard_normal(V.shape)
-
-    def idx(x, y):
-        return (x % n) * n + y % n
-
-    F = [[idx(x, y), idx(x + 1, y), idx(x + 1, y + 1)] for x in range(n) for y in range(n)]
-    F += [[idx(x, y), idx(x + 1, y + 1), idx(x, y + 1)] for x in range(n) for y in range(n)]
-    return V, np.array(F)
+    V, F = regular_torus(n)
+    return V + 0.05 * np.random.default_rng(seed).standard_normal(V.shape), F
 
 
 def _grid(n=6, seed=9):
