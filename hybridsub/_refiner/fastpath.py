@@ -127,12 +127,27 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
         r = refinement_of(inp, progress)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
-    last = None
-    for last in walk_data(inp, Vf, tags=False, progress=progress):
-        pass
-    if last is None:  # no step ran: copies of the input
+    X, faces = _last_level(inp, Vf, progress)
+    if faces is None:  # no step ran: copies of the input
         return Vf.astype(out_dtype, copy=True), inp.faces.copy()
-    return last.X.astype(out_dtype, copy=False), last.faces
+    return X.astype(out_dtype, copy=False), faces
+
+
+def _last_level(inp: RefineInput, X: np.ndarray, progress: bool | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The positions and faces of the last level (faces None if no step ran), holding as
+    little at once as the steps allow: each step refines the data before it emits its faces,
+    the last one drops its vertex weights and tags first, and nothing keeps the levels before."""
+    data = [X]
+
+    def refine(level, plan):
+        data[0] = apply_step(level, plan, data[0])
+
+    faces = None
+    for s in walk(inp, Budget(inp.levels, inp.scheme, inp.max_memory, keeps_steps=False), topology_last=False,
+                  progress=progress, data_first=refine):
+        faces = s.faces
+        del s
+    return data[0], faces
 
 
 @dataclass(frozen=True, eq=False)

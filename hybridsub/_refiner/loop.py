@@ -14,7 +14,8 @@ is turned into matrices (:mod:`.refinement`) or applied to data directly (:mod:`
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import dataclasses
+from collections.abc import Callable, Iterator
 from typing import NamedTuple
 
 import numpy as np
@@ -24,6 +25,11 @@ from .._rules import refinement as R
 from .._topology import Level, StepPlan, child_level, plan_step
 from .bar import level_bar, tick
 from .budget import Budget
+
+
+#: What ``walk(..., data_first=...)`` calls with each step's level and plan.
+DataFirst = Callable[[Level, StepPlan], None]
+EMPTY_WEIGHTS = np.empty((4, 0), np.float64)
 
 
 class UVStep(NamedTuple):
@@ -48,23 +54,28 @@ class Step(NamedTuple):
 
 
 def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = True,
-         progress: bool | None = False) -> Iterator[Step]:
+         progress: bool | None = False, data_first: DataFirst | None = None) -> Iterator[Step]:
     """Run ``inp.levels`` steps; yield a :class:`Step` for each (none without faces).
 
     The next level's twins and tags are built for the last step only if ``topology_last``
     (always with face-varying data). ``budget`` may refuse before the first step allocates.
     ``progress``: a tqdm bar ticks after each step has been used (see :func:`.bar.level_bar`).
+    ``data_first(level, plan)``, if given, is called before each step's faces are emitted (to
+    refine the caller's data); then, on a last step without topology, the plan's vertex
+    weights and the level's tags are dropped, so the new faces are not allocated beside them
+    (the step yields the plan without ``coefficients`` and the level without ``hsharp``).
     """
     if inp.levels == 0 or inp.n_faces == 0:
         return
     with level_bar(inp.levels, progress, inp.scheme) as bar:
-        for s in _steps(inp, budget, topology_last):
+        for s in _steps(inp, budget, topology_last, data_first):
             yield s
             tick(bar, len(s.faces))
             del s  # nor here: the last step's plan and offsets are dropped before the next one's
 
 
-def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool) -> Iterator[Step]:
+def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool,
+           data_first: DataFirst | None) -> Iterator[Step]:
     level, corner = inp.level, inp.corner
     uvl = uv_fixed = None
     if inp.uv is not None:
@@ -83,6 +94,11 @@ def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool) -> Iter
         if budget is not None:  # before this step allocates anything large
             budget.check(step, level, plan, also=None if uvl is None else (uvl, uv_plan))
         want = topology_last or step < inp.levels or uvl is not None
+        if data_first is not None:
+            data_first(level, plan)
+            if not want:
+                plan = dataclasses.replace(plan, coefficients=EMPTY_WEIGHTS)
+                level = Level(level.faces, level.n_vertices, level.twin, None, level.face_sharp)
         faces, child, offsets = child_level(level, plan, want_topology=want)
         uv = None
         if uvl is not None:

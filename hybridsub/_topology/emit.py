@@ -30,7 +30,7 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     m = level.n_faces
     face_sharp = level.face_sharp
     offsets = np.empty(m + 1, np.int64)
-    first = np.empty(3 * m, np.int64)
+    first = np.empty(3 * m, np.int32)  # child face numbers: fewer than 4m (plan_step checks 2³¹)
     K.child_offsets(plan.hkind, face_sharp, offsets, first)
     total = int(offsets[m])
     has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
@@ -70,7 +70,7 @@ def child_creases(level: Level, plan: StepPlan):
     F = level.faces
     f, i = keep // 3, keep % 3
     u, w = F[f, i], F[f, (i + 1) % 3]
-    mid = plan.edge_point[keep]
+    mid = plan.edge_point[keep].astype(np.int64)
     pairs = np.empty((2 * len(keep), 2), np.int64)
     pairs[0::2, 0] = u
     pairs[0::2, 1] = mid

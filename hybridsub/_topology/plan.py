@@ -20,6 +20,10 @@ from .._rules import refinement as R
 from . import _kernels as K
 from .level import Level
 
+#: Most vertices a level may have: a step plan numbers its new points in int32 (half the
+#: memory of int64; 2³¹ vertices would take 50 GB for their positions alone).
+INDEX_LIMIT = 2**31 - 1
+
 
 #: Empty arrays handed to kernels in place of an absent input.
 EMPTY_FLOAT = np.empty(0, np.float64)
@@ -34,8 +38,8 @@ class StepPlan:
     scheme: str
     step: int  # 1-based within the call; only "sqrt3" cares (Kobbelt's odd/even boundary)
     hkind: np.ndarray  # (3m,) int8 EDGE_* code of each halfedge's edge
-    edge_point: np.ndarray  # (3m,) index of the (first) new point on each halfedge's edge, −1 if none
-    face_point: np.ndarray  # (m,) index of the face point, −1 if none
+    edge_point: np.ndarray  # (3m,) int32 index of the (first) new point on each halfedge's edge, −1 if none
+    face_point: np.ndarray  # (m,) int32 index of the face point, −1 if none
     trisected: np.ndarray  # (m,) int8 local index of the trisected boundary halfedge, −1 if none
     coefficients: np.ndarray  # (4, n): every vertex mask, see _rules.vertex_mask
     n_new: int
@@ -58,9 +62,12 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     odd = step % 2 == 1
     sqrt3 = scheme == "sqrt3"
     has_tags = level.hsharp is not None and not sqrt3
+    if n + 4 * m > INDEX_LIMIT:  # new points: at most two per edge (≤ 3m/2 edges) and one per face
+        raise MemoryError(f"a step of {m:,} faces and {n:,} vertices could make more than {INDEX_LIMIT:,} vertices, "
+                          "more than the int32 indices of a step plan hold")
     hkind = np.empty(3 * m, np.int8)
-    edge_point = np.empty(3 * m, np.int64)
-    face_point = np.empty(m, np.int64)
+    edge_point = np.empty(3 * m, np.int32)
+    face_point = np.empty(m, np.int32)
     trisected = np.empty(m, np.int8)
     counts = np.zeros((6, n), np.int64)
     s_frac = np.zeros(n, np.float64)
