@@ -128,7 +128,7 @@ def smooth_weight_table(max_valence, loop_weights="loop"):
                      for r in (REGION_SQRT3, REGION_LOOP, REGION_MIXED)])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # called per edge or vertex: a call costs more than the rule
 def vertex_rule(crease_count, is_corner):
     """Rule of a vertex from its number of incident creases and its corner tag."""
     if is_corner or crease_count >= 3:
@@ -138,7 +138,7 @@ def vertex_rule(crease_count, is_corner):
     return SMOOTH
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # called per edge or vertex: a call costs more than the rule
 def vertex_mask(n, rule_parent, rule_child, blend, smooth_w, cs, cn):
     """A vertex point's mask as four coefficients: (self, every neighbour, each neighbour
     along a crease of this level (s > 0), each neighbour along a crease of the next level
@@ -163,7 +163,7 @@ def vertex_mask(n, rule_parent, rule_child, blend, smooth_w, cs, cn):
     return a + (1.0 - w) * (1.0 - n * smooth_w), (1.0 - w) * smooth_w, p, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # called per edge or vertex: a call costs more than the rule
 def edge_weights(s):
     """Edge point weights (each end, each opposite vertex) for an edge of sharpness s.
 
