@@ -210,6 +210,35 @@ def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk
                 out[q, v, r] = buf[s, v, r]
 
 
+@kernel(inline="always")
+def _gather33(q, rows, b, n, order, vids, X, res):
+    """The last loop of :func:`_back_points` for three rows of three-column data, its nine
+    sums in registers (``res`` is zero on entry): the same additions in the same order."""
+    s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
+    for k in range(n):
+        loc = order[b + k]
+        col = vids[b + loc]
+        x0, x1, x2 = X[col, 0], X[col, 1], X[col, 2]
+        a = rows[loc, 0]
+        if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
+            s00 += a * x0
+            s01 += a * x1
+            s02 += a * x2
+        a = rows[loc, 1]
+        if a != 0.0:
+            s10 += a * x0
+            s11 += a * x1
+            s12 += a * x2
+        a = rows[loc, 2]
+        if a != 0.0:
+            s20 += a * x0
+            s21 += a * x1
+            s22 += a * x2
+    res[0, q, 0], res[0, q, 1], res[0, q, 2] = s00, s01, s02
+    res[1, q, 0], res[1, q, 1], res[1, q, 2] = s10, s11, s12
+    res[2, q, 0], res[2, q, 1], res[2, q, 2] = s20, s21, s22
+
+
 def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
                  t_row, t_col, t_val, base, order, vids, X, res):
     """:func:`back_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
@@ -224,15 +253,18 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
         for q in range(task * TASK, min(len(stop), (task + 1) * TASK)):
             s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
                           t_start, t_end, t_row, t_col, t_val)
-            b = base[q]
-            for k in range(nv[keys[q, 0]]):
-                loc = order[b + k]
-                col = vids[b + loc]
-                for r in range(W.shape[1]):
-                    a = buf[s, loc, r]
-                    if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
-                        for d in range(X.shape[1]):
-                            res[r, q, d] += a * X[col, d]
+            if W.shape[1] == 3 and X.shape[1] == 3:
+                _gather33(q, buf[s], base[q], nv[keys[q, 0]], order, vids, X, res)
+            else:
+                b = base[q]
+                for k in range(nv[keys[q, 0]]):
+                    loc = order[b + k]
+                    col = vids[b + loc]
+                    for r in range(W.shape[1]):
+                        a = buf[s, loc, r]
+                        if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
+                            for d in range(X.shape[1]):
+                                res[r, q, d] += a * X[col, d]
 
 
 back_points, back_points_serial = threaded_and_serial(_back_points)
