@@ -98,3 +98,40 @@ def test_threaded_kernels_equal_serial_bit_for_bit(data, scheme, levels):
     assert np.array_equal(serial[0], threaded[0]) and np.array_equal(serial[1], threaded[1])
     assert np.array_equal(serial_apply, threaded_apply)
     assert np.array_equal(serial_apply, serial[0])
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tagged_meshes("any"), st.sampled_from(["hybrid", "loop", "sqrt3"]), st.booleans(), st.integers(1, 7),
+       st.integers(0, 2**32 - 1))
+def test_classification_in_chunks_equals_the_serial_pass(data, scheme, odd, chunks, seed):
+    """classify_step_chunks (big meshes, on threads) numbers points, kinds and per-vertex
+    counts exactly as classify_step does, for any number of chunks, with forced splits too."""
+    from hybridsub._rules import refinement as R
+
+    V, F, tags = data
+    if scheme == "sqrt3":
+        tags = {}
+    level = open_gate(F, tags.get("sharp_edges"), 1, n_vertices=len(V), scheme=scheme,
+                      sharpness=tags.get("sharpness"), sharp_faces=tags.get("sharp_faces")).level
+    m, n = level.n_faces, level.n_vertices
+    has_tags = level.hsharp is not None and scheme != "sqrt3"
+    force = np.zeros(0, bool)
+    if scheme != "sqrt3":  # seams: both halfedges of an edge
+        h = np.flatnonzero(np.random.default_rng(seed).random(3 * m) < 0.2)
+        h = h[level.twin[h] >= 0]
+        force = np.zeros(3 * m, bool)
+        force[h] = force[level.twin[h]] = True
+    n_sharp = int(np.count_nonzero(level.face_sharp))
+
+    def run(kernel, *extra):
+        out = (np.empty(3 * m, np.int8), np.empty(3 * m, np.int32), np.empty(m, np.int32), np.empty(m, np.int8),
+               np.zeros((6, n), np.int64), np.zeros(n))
+        n_new = kernel(level.faces, level.twin, level.hsharp if has_tags else np.empty(0), has_tags, level.face_sharp,
+                       0 < n_sharp < m, force, R.SCHEME_CODES[scheme], odd, *out, *extra)
+        return n_new, out
+
+    n_serial, serial = run(K.classify_step)
+    n_chunks, chunked = run(K.classify_step_chunks, chunks)
+    assert n_chunks == n_serial
+    for a, b in zip(serial, chunked):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
