@@ -290,8 +290,7 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
 
     Each chunk of faces first counts its new points; the numbering then starts each chunk
     where the chunks before it end, so points are numbered as the serial pass numbers them.
-    The per-vertex numbers are gathered by vertex ranges: each thread walks every edge and
-    keeps its own vertices' terms, so ``s_frac`` sums in the same order.
+    The per-vertex numbers are gathered by vertex ranges (:func:`_count_range`).
     """
     m = F.shape[0]
     n = counts.shape[1]
@@ -313,6 +312,8 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
             new_f += 1 if has else 0
         edge_start[c + 1] = new_e
         face_start[c + 1] = new_f
+        _count_range(c * n // chunks, (c + 1) * n // chunks, F, twin, hsharp, has_tags, face_sharp, mixed, counts,
+                     s_frac)
     edge_start[0] = n
     for c in range(chunks):
         edge_start[c + 1] += edge_start[c]
@@ -329,50 +330,53 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
                     new = _new_on_edge(hkind[h])
                     edge_point[h] = nxt if new else -1
                     nxt += new
-            has, _ = _face_has_point(f, twin, face_sharp, sqrt3, odd)
-            face_point[f] = nfp if has else -1
-            nfp += 1 if has else 0
+            face_point[f] = nfp if _face_has_point(f, twin, face_sharp, sqrt3, odd)[0] else -1
+            nfp += 1 if face_point[f] >= 0 else 0
     for h in prange(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
             hkind[h] = hkind[t]
             edge_point[h] = edge_point[t]
-    for c in prange(chunks):
-        lo = c * n // chunks
-        hi = (c + 1) * n // chunks
-        for h in range(3 * m):
-            t = twin[h]
-            if t >= 0 and t < h:
-                continue
-            u = origin(F, h)
-            w = dest(F, h)
-            mine_u = lo <= u < hi
-            mine_w = lo <= w < hi
-            if mine_u or mine_w:
-                s = edge_sharpness(h, twin, hsharp, has_tags)
-                if mine_u:
-                    _count_end(u, s, counts, s_frac)
-                if mine_w:
-                    _count_end(w, s, counts, s_frac)
-        if mixed:
-            for f in range(m):
-                sh = 1 if face_sharp[f] else 0
-                for i in range(3):
-                    v = F[f, i]
-                    if lo <= v < hi:
-                        counts[4, v] += 1
-                        counts[5, v] += sh
     return face_start[chunks]
 
 
-def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
+@kernel(inline="always")
+def _count_range(lo, hi, F, twin, hsharp, has_tags, face_sharp, mixed, counts, s_frac):
+    """:func:`classify_step`'s per-vertex numbers for the vertices ``lo:hi``: every edge is
+    walked and only those vertices' terms kept, so each sum runs in the serial order."""
+    for h in range(3 * F.shape[0]):
+        t = twin[h]
+        if t >= 0 and t < h:
+            continue
+        u = origin(F, h)
+        w = dest(F, h)
+        mine_u = lo <= u < hi
+        mine_w = lo <= w < hi
+        if mine_u or mine_w:
+            s = edge_sharpness(h, twin, hsharp, has_tags)
+            if mine_u:
+                _count_end(u, s, counts, s_frac)
+            if mine_w:
+                _count_end(w, s, counts, s_frac)
+    if mixed:
+        for f in range(F.shape[0]):
+            sh = 1 if face_sharp[f] else 0
+            for i in range(3):
+                v = F[f, i]
+                if lo <= v < hi:
+                    counts[4, v] += 1
+                    counts[5, v] += sh
+
+
+@kernel
+def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
                         coefficients):
     """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
     parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
     non-smooth vertex (Kobbelt's odd steps). ``region_of_all`` is every vertex's region when
     the faces are all sharp or all smooth, −1 when the counts must decide."""
     n = counts.shape[1]
-    for v in prange(n):
+    for v in range(n):
         rp = vertex_rule(counts[1, v], corner[v])
         rc = vertex_rule(counts[2, v], corner[v])
         if fix_boundary and rp != SMOOTH:
@@ -393,9 +397,6 @@ def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs
         coefficients[1, v] = b
         coefficients[2, v] = p
         coefficients[3, v] = c
-
-
-vertex_coefficients, vertex_coefficients_serial = threaded_and_serial(_vertex_coefficients)
 
 
 # ---------------------------------------------------------------------------------------
