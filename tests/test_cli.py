@@ -40,6 +40,7 @@ def _write(path, text):
 # end to end, in a subprocess
 
 
+@pytest.mark.slow  # two subprocesses, ~3 s; .ci/run runs the slow tests
 def test_subdivide_writes_tags_that_the_next_run_uses(tmp_path, capsys):
     """cube-meshed, creases at 30°: two runs of one level through an OBJ with tags give what one
     run of two levels gives, and the file holds the propagated tags."""
@@ -134,6 +135,7 @@ def test_demo_runs_without_arguments(tmp_path):
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs a pseudo-terminal")
+@pytest.mark.slow  # a subprocess on a pseudo-terminal, ~2 s; .ci/run runs the slow tests
 def test_progress_bar_on_a_terminal(tmp_path):
     import pty
 

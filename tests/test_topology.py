@@ -5,6 +5,7 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from hybridsub._topology import _classify_kernels as C
 from hybridsub._topology import _kernels as K
 from hybridsub import refine
 from hybridsub._input.gate import open_gate
@@ -100,7 +101,7 @@ def test_threaded_kernels_equal_serial_bit_for_bit(data, scheme, levels):
     assert np.array_equal(serial_apply, serial[0])
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(tagged_meshes("any"), st.sampled_from(["hybrid", "loop", "sqrt3"]), st.booleans(), st.integers(1, 7),
        st.integers(0, 2**32 - 1))
 def test_classification_in_chunks_equals_the_serial_pass(data, scheme, odd, chunks, seed):
@@ -130,8 +131,8 @@ def test_classification_in_chunks_equals_the_serial_pass(data, scheme, odd, chun
                        0 < n_sharp < m, force, R.SCHEME_CODES[scheme], odd, *out, *extra)
         return n_new, out
 
-    n_serial, serial = run(K.classify_step)
-    n_chunks, chunked = run(K.classify_step_chunks, chunks)
+    n_serial, serial = run(C.classify_step)
+    n_chunks, chunked = run(C.classify_step_chunks, chunks)
     assert n_chunks == n_serial
     for a, b in zip(serial, chunked):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()

@@ -1,5 +1,5 @@
-"""Numba kernels of the topology layer: twins, edge numbering, classification, vertex
-coefficients and the emission of the next level.
+"""Numba kernels of the topology layer: twins, edge numbering and the emission of the next
+level (a step's classification is in ``_classify_kernels``).
 
 Private. Every kernel takes contiguous arrays (int64 indices, float64 data, int8 codes,
 bool masks) and plain scalars; no Python objects. Large outputs are allocated by the
@@ -8,8 +8,8 @@ several times cheaper than Numba's own allocations) and filled here. Halfedges a
 (see ``_halfedge_kernels``). An edge is *owned* by its lower-numbered halfedge, and edges are
 numbered in owner order: the order of first appearance over the halfedges.
 
-One step runs ``classify_step`` (edge kinds, new-point layout, vertex statistics), then
-``vertex_coefficients`` (each vertex mask as four numbers, from ``_rules``); the refiner's
+One step runs ``_classify_kernels.classify_step`` (edge kinds, new-point layout, vertex
+statistics), then ``vertex_coefficients`` (each vertex mask as four numbers); the refiner's
 stencil kernels turn these into rows of S; ``emit_faces`` with ``emit_topology`` make the next
 level's faces, then its twins and tags, derived from this level's instead of searched again.
 """
@@ -21,20 +21,12 @@ from numba import prange
 
 from .._jit import kernel, threaded_and_serial
 from .._rules.refinement import (
-    CORNER,
     EDGE_FLIP,
     EDGE_KEEP,
     EDGE_SPLIT,
     EDGE_TRISECT,
-    REGION_LOOP,
-    REGION_MIXED,
-    REGION_SQRT3,
-    SCHEME_SQRT3,
-    SMOOTH,
-    vertex_mask,
-    vertex_rule,
 )
-from ._halfedge_kernels import dest, edge_sharpness, next_in_face, origin, prev_in_face
+from ._halfedge_kernels import dest, next_in_face, prev_in_face
 
 # Error codes of halfedge_twins.
 OK = 0
@@ -181,222 +173,6 @@ def boundary_links(F, twin):
         bnext[h] = g
         bprev[g] = h
     return bnext, bprev
-
-
-# ---------------------------------------------------------------------------------------
-# Classification of one step.
-
-
-@kernel(inline="always")
-def _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd):
-    """The kind of edge ``h`` (twin ``t``, sharpness ``s``) this step."""
-    if sqrt3:
-        if t < 0:
-            return EDGE_KEEP if odd else EDGE_TRISECT
-        return EDGE_FLIP
-    if (s > 0.0 or face_sharp[h // 3] or (t >= 0 and face_sharp[t // 3])
-            or (force_split.shape[0] > 0 and force_split[h])):
-        return EDGE_SPLIT
-    return EDGE_FLIP
-
-
-@kernel(inline="always")
-def _new_on_edge(k):
-    """How many new points an edge of kind ``k`` gets."""
-    if k == EDGE_SPLIT:
-        return 1
-    if k == EDGE_TRISECT:
-        return 2
-    return 0
-
-
-@kernel(inline="always")
-def _face_has_point(f, twin, face_sharp, sqrt3, odd):
-    """(whether face ``f`` gets a face point, its trisected boundary halfedge or −1)."""
-    if not sqrt3:
-        return not face_sharp[f], -1
-    tri = -1
-    if not odd:
-        for i in range(3):
-            if twin[3 * f + i] < 0:
-                tri = i
-    return tri < 0, tri
-
-
-@kernel(inline="always")
-def _count_end(v, s, counts, s_frac):
-    """Vertex ``v``'s share of an edge of sharpness ``s`` in ``counts`` and ``s_frac``."""
-    counts[0, v] += 1
-    if s > 0.0:
-        counts[1, v] += 1
-        if s > 1.0:
-            counts[2, v] += 1
-        else:
-            counts[3, v] += 1
-            s_frac[v] += s
-
-
-@kernel
-def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, scheme, odd, hkind, edge_point,
-                  face_point, trisected, counts, s_frac):
-    """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.
-
-    ``force_split`` (3m,) bool, or empty: edges to split even between smooth faces (UV
-    seams). Fills ``hkind`` and ``edge_point`` (3m,): each halfedge's edge kind and the index of the
-    (first) point on its edge or −1; ``face_point`` (m,) likewise; ``trisected`` (m,) the
-    local index of a face's trisected boundary halfedge or −1. ``counts`` (6, n), zeroed
-    by the caller, receives per vertex: valence, incident edges with s > 0, with s > 1, with
-    0 < s ≤ 1, incident faces, incident sharp faces (the last two only if ``mixed``: some
-    faces are sharp and some not); ``s_frac`` (n,), zeroed, the sum of s over edges with
-    0 < s ≤ 1. Returns the number of vertices of the next level. New points are numbered
-    edge points first (in owner halfedge order), then face points (in face order).
-    :func:`classify_step_chunks` gives the same on threads.
-    """
-    m = F.shape[0]
-    n = counts.shape[1]
-    sqrt3 = scheme == SCHEME_SQRT3
-    nxt = n
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            hkind[h] = hkind[t]
-            edge_point[h] = edge_point[t]
-            continue
-        s = edge_sharpness(h, twin, hsharp, has_tags)
-        k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
-        hkind[h] = k
-        new = _new_on_edge(k)
-        edge_point[h] = nxt if new else -1
-        nxt += new
-        _count_end(origin(F, h), s, counts, s_frac)
-        _count_end(dest(F, h), s, counts, s_frac)
-    for f in range(m):
-        has, trisected[f] = _face_has_point(f, twin, face_sharp, sqrt3, odd)
-        face_point[f] = nxt if has else -1
-        nxt += 1 if has else 0
-        if mixed:
-            sh = 1 if face_sharp[f] else 0
-            for i in range(3):
-                v = F[f, i]
-                counts[4, v] += 1
-                counts[5, v] += sh
-    return nxt
-
-
-@kernel(parallel=True)
-def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, scheme, odd, hkind, edge_point,
-                         face_point, trisected, counts, s_frac, chunks):
-    """:func:`classify_step` on ``chunks`` threads, with the same output to the bit.
-
-    Each chunk of faces first counts its new points; the numbering then starts each chunk
-    where the chunks before it end, so points are numbered as the serial pass numbers them.
-    The per-vertex numbers are gathered by vertex ranges (:func:`_count_range`).
-    """
-    m = F.shape[0]
-    n = counts.shape[1]
-    sqrt3 = scheme == SCHEME_SQRT3
-    edge_start = np.zeros(chunks + 1, np.int64)
-    face_start = np.zeros(chunks + 1, np.int64)
-    for c in prange(chunks):
-        new_e = 0
-        new_f = 0
-        for f in range(c * m // chunks, (c + 1) * m // chunks):
-            for h in range(3 * f, 3 * f + 3):
-                t = twin[h]
-                if t < 0 or t > h:
-                    k = _edge_kind(h, t, edge_sharpness(h, twin, hsharp, has_tags), face_sharp, force_split, sqrt3,
-                                   odd)
-                    hkind[h] = k
-                    new_e += _new_on_edge(k)
-            has, trisected[f] = _face_has_point(f, twin, face_sharp, sqrt3, odd)
-            new_f += 1 if has else 0
-        edge_start[c + 1] = new_e
-        face_start[c + 1] = new_f
-        _count_range(c * n // chunks, (c + 1) * n // chunks, F, twin, hsharp, has_tags, face_sharp, mixed, counts,
-                     s_frac)
-    edge_start[0] = n
-    for c in range(chunks):
-        edge_start[c + 1] += edge_start[c]
-    face_start[0] = edge_start[chunks]
-    for c in range(chunks):
-        face_start[c + 1] += face_start[c]
-    for c in prange(chunks):
-        nxt = edge_start[c]
-        nfp = face_start[c]
-        for f in range(c * m // chunks, (c + 1) * m // chunks):
-            for h in range(3 * f, 3 * f + 3):
-                t = twin[h]
-                if t < 0 or t > h:
-                    new = _new_on_edge(hkind[h])
-                    edge_point[h] = nxt if new else -1
-                    nxt += new
-            face_point[f] = nfp if _face_has_point(f, twin, face_sharp, sqrt3, odd)[0] else -1
-            nfp += 1 if face_point[f] >= 0 else 0
-    for h in prange(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            hkind[h] = hkind[t]
-            edge_point[h] = edge_point[t]
-    return face_start[chunks]
-
-
-@kernel(inline="always")
-def _count_range(lo, hi, F, twin, hsharp, has_tags, face_sharp, mixed, counts, s_frac):
-    """:func:`classify_step`'s per-vertex numbers for the vertices ``lo:hi``: every edge is
-    walked and only those vertices' terms kept, so each sum runs in the serial order."""
-    for h in range(3 * F.shape[0]):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = origin(F, h)
-        w = dest(F, h)
-        mine_u = lo <= u < hi
-        mine_w = lo <= w < hi
-        if mine_u or mine_w:
-            s = edge_sharpness(h, twin, hsharp, has_tags)
-            if mine_u:
-                _count_end(u, s, counts, s_frac)
-            if mine_w:
-                _count_end(w, s, counts, s_frac)
-    if mixed:
-        for f in range(F.shape[0]):
-            sh = 1 if face_sharp[f] else 0
-            for i in range(3):
-                v = F[f, i]
-                if lo <= v < hi:
-                    counts[4, v] += 1
-                    counts[5, v] += sh
-
-
-@kernel
-def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
-                        coefficients):
-    """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
-    parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
-    non-smooth vertex (Kobbelt's odd steps). ``region_of_all`` is every vertex's region when
-    the faces are all sharp or all smooth, −1 when the counts must decide."""
-    n = counts.shape[1]
-    for v in range(n):
-        rp = vertex_rule(counts[1, v], corner[v])
-        rc = vertex_rule(counts[2, v], corner[v])
-        if fix_boundary and rp != SMOOTH:
-            rp = CORNER
-            rc = CORNER
-        if region_of_all >= 0:
-            region = region_of_all
-        elif counts[5, v] == 0:
-            region = REGION_SQRT3
-        elif counts[5, v] == counts[4, v]:
-            region = REGION_LOOP
-        else:
-            region = REGION_MIXED
-        blend = s_frac[v] / counts[3, v] if counts[3, v] > 0 else 0.0
-        val = counts[0, v]
-        a, b, p, c = vertex_mask(val, rp, rc, blend, weight_table[region, val], cs, cn)
-        coefficients[0, v] = a
-        coefficients[1, v] = b
-        coefficients[2, v] = p
-        coefficients[3, v] = c
 
 
 # ---------------------------------------------------------------------------------------

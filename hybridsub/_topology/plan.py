@@ -18,6 +18,7 @@ import numba
 import numpy as np
 
 from .._rules import refinement as R
+from . import _classify_kernels as C
 from . import _kernels as K
 from .level import Level
 
@@ -80,11 +81,11 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     region_of_all = -1 if mixed else (R.REGION_LOOP if n_sharp else R.REGION_SQRT3)
     args = (F, twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, level.face_sharp, mixed, force,
             R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts, s_frac)
-    n_new = K.classify_step_chunks(*args, numba.get_num_threads()) if K.use_threads(m) else K.classify_step(*args)
+    n_new = C.classify_step_chunks(*args, numba.get_num_threads()) if K.use_threads(m) else C.classify_step(*args)
     table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
-    K.vertex_coefficients(counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
+    C.vertex_coefficients(counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
     if sqrt3 and not odd:
         bnext, bprev = K.boundary_links(F, twin)
     else:
