@@ -36,8 +36,9 @@ class LimitSurface:
         As for :func:`hybridsub.refine`; every scheme and tag.
     depth : int, optional
         Levels of exact local refinement before the last interpolation (default 24 for
-        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``: 1e-12 × the diagonal or better,
-        see ``docs/limit.md``).
+        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``: 1e-12 × the diagonal or better
+        at random points; in a narrow band round the hybrid's crease vertices, on their smooth
+        side, up to 5e-9 — see ``docs/limit.md``).
 
     Notes
     -----
