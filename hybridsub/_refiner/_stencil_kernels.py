@@ -16,7 +16,7 @@ from numba import prange
 
 from .._jit import kernel, threaded_and_serial
 from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
-from .._topology import dest, edge_sharpness, opposite, origin
+from .._topology import dest, edge_sharpness, opposite, origin, owned_ends_in
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
 _THIRD = 1.0 / 3.0
@@ -50,13 +50,7 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
             for j in range(k):
                 out[v, j] = coef[0, v] * X[v, j]
         for h in range(3 * m):
-            t = twin[h]
-            if t >= 0 and t < h:
-                continue
-            u = origin(F, h)
-            w = dest(F, h)
-            mine_u = lo <= u < hi
-            mine_w = lo <= w < hi
+            u, w, mine_u, mine_w = owned_ends_in(F, twin, h, lo, hi)
             if not (mine_u or mine_w):
                 continue
             s = edge_sharpness(h, twin, hsharp, has_tags)

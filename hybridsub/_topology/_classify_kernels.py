@@ -26,7 +26,7 @@ from .._rules.refinement import (
     vertex_mask,
     vertex_rule,
 )
-from ._halfedge_kernels import dest, edge_sharpness, origin
+from ._halfedge_kernels import dest, edge_sharpness, origin, owned_ends_in
 
 
 @kernel(inline="always")
@@ -187,13 +187,7 @@ def _count_range(lo, hi, F, twin, hsharp, has_tags, face_sharp, mixed, counts, s
     """:func:`classify_step`'s per-vertex numbers for the vertices ``lo:hi``: every edge is
     walked and only those vertices' terms kept, so each sum runs in the serial order."""
     for h in range(3 * F.shape[0]):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = origin(F, h)
-        w = dest(F, h)
-        mine_u = lo <= u < hi
-        mine_w = lo <= w < hi
+        u, w, mine_u, mine_w = owned_ends_in(F, twin, h, lo, hi)
         if mine_u or mine_w:
             s = edge_sharpness(h, twin, hsharp, has_tags)
             if mine_u:

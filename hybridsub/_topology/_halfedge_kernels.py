@@ -54,3 +54,17 @@ def edge_sharpness(h, twin, hsharp, has_tags):
     if has_tags:
         return hsharp[h]
     return 0.0
+
+
+@kernel(inline="always")
+def owned_ends_in(F, twin, h, lo, hi):
+    """(u, w, u in lo:hi, w in lo:hi) for the edge u→w of halfedge h if h owns it (the
+    lower-numbered halfedge of the edge), else two Falses: a walk over every edge that keeps
+    one range of vertices' terms, in the serial order, as the threaded kernels do."""
+    t = twin[h]
+    u = origin(F, h)
+    w = dest(F, h)
+    if t >= 0 and t < h:
+        return u, w, False, False
+    return u, w, lo <= u < hi, lo <= w < hi
+
