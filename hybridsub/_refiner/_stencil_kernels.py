@@ -215,6 +215,20 @@ def _csr_apply(indptr, indices, data, X, out):
 csr_apply, csr_apply_serial = threaded_and_serial(_csr_apply)
 
 
+@kernel
+def product_bound(a_indptr, a_indices, b_indptr, n_cols):
+    """Entries ``A @ B`` can have at most (CSR patterns): row i of the product has at most
+    ``sum(nnz(B[j]) for j in A[i])`` entries, and at most ``n_cols``."""
+    total = 0
+    for i in range(len(a_indptr) - 1):
+        row = 0
+        for q in range(a_indptr[i], a_indptr[i + 1]):
+            j = a_indices[q]
+            row += b_indptr[j + 1] - b_indptr[j]
+        total += min(row, n_cols)
+    return total
+
+
 # ---------------------------------------------------------------------------------------
 # Coded stencils: a CSR matrix whose few distinct weights are stored once, each entry
 # holding a one-byte code into that table (5 bytes an entry instead of 12 with int32

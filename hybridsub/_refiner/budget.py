@@ -38,6 +38,7 @@ import numpy as np
 
 from .._rules import refinement as R
 from . import stencils as _stencils
+from ._stencil_kernels import product_bound
 from .._errors import OutputTooLargeError
 from .._input import count_of
 from .._topology import edge_keys, undirected_edges
@@ -370,11 +371,7 @@ def check_product(A, B, max_memory=None, what="the composite refinement matrix")
     limit, source = _resolve(max_memory)
     if not math.isfinite(limit):
         return
-    rows_b = np.diff(B.indptr).astype(np.int64)
-    per_entry = rows_b[A.indices]
-    row_of = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
-    bound = np.minimum(np.bincount(row_of, weights=per_entry, minlength=A.shape[0]), B.shape[1])
-    nnz = float(bound.sum())
+    nnz = float(product_bound(A.indptr, A.indices, B.indptr, B.shape[1]))
     idx = 8 if max(nnz, B.shape[1], A.shape[0]) >= _stencils.INT32_LIMIT else 4
     # the product, and scipy's temporaries (about as large again)
     need = 2 * (nnz * (8 + idx) + (A.shape[0] + 1) * idx)
