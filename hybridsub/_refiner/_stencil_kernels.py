@@ -231,15 +231,16 @@ def product_bound(a_indptr, a_indices, b_indptr, n_cols):
 
 # ---------------------------------------------------------------------------------------
 # Coded stencils: a CSR matrix whose few distinct weights are stored once, each entry
-# holding a one-byte code into that table (5 bytes an entry instead of 12 with int32
-# indices). The products sum each row in stored order, as ``_csr_apply``: the same bits.
+# holding a uint16 code into that table and a uint16 column where the columns allow (4 bytes
+# an entry instead of 12 with int32 indices). The products sum each row in stored order, as
+# ``_csr_apply``: the same bits.
 
 _EMPTY_KEY = -1  # a slot of the hash table holding no weight (no float64 has these bits: a NaN)
 
 
 @kernel
 def weight_codes(bits, codes, table):
-    """Fill ``codes`` (uint8) with the index in ``table`` of each weight, whose float64 bits
+    """Fill ``codes`` (uint16) with the index in ``table`` of each weight, whose float64 bits
     are ``bits`` (int64); ``table`` (int64, its length the most codes) collects the distinct
     bits in order of first use. Returns their number, or -1 when there are more."""
     slots = 4 * table.shape[0]

@@ -172,8 +172,9 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
                     new = _new_on_edge(hkind[h])
                     edge_point[h] = nxt if new else -1
                     nxt += new
-            face_point[f] = nfp if _face_has_point(f, twin, face_sharp, sqrt3, odd)[0] else -1
-            nfp += 1 if face_point[f] >= 0 else 0
+            has, _ = _face_has_point(f, twin, face_sharp, sqrt3, odd)
+            face_point[f] = nfp if has else -1
+            nfp += 1 if has else 0
     for h in prange(3 * m):
         t = twin[h]
         if t >= 0 and t < h:
