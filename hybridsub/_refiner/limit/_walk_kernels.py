@@ -20,13 +20,13 @@ TASK = 64
 
 
 @kernel(inline="always")
-def _pick_one(q, k, bary, uv, cand_start, cand_count, M, b):
+def _pick_one(q, k, bary, grad, cand_start, cand_count, M, b):
     """Point ``q``'s child face among key ``k``'s candidates (the largest smallest barycentric
     coordinate; the first of those equal to ``TIE``, so a point on an edge stays on the
-    centre face's side): its coordinates there and the child's corners in (u, v) replace
-    ``bary[q]`` and ``uv[q]``. ``M`` (c, 3, 3) takes a point's barycentric coordinates into
-    each candidate's; its inverse transposed holds the candidate's corners over the face.
-    Returns the candidate."""
+    centre face's side): its coordinates there and their derivatives in (u, v) replace
+    ``bary[q]`` and ``grad[q]`` (3, 2). ``M`` (c, 3, 3) takes a point's barycentric
+    coordinates into each candidate's, so it takes their derivatives too. Returns the
+    candidate."""
     s = cand_start[k]
     best = -np.inf
     chosen = -1
@@ -42,30 +42,23 @@ def _pick_one(q, k, bary, uv, cand_start, cand_count, M, b):
             nb0, nb1, nb2 = b[0], b[1], b[2]
     j = chosen
     bary[q, 0], bary[q, 1], bary[q, 2] = nb0, nb1, nb2
-    # G = (Mᵀ)⁻¹: the cofactors of M over its determinant.
-    det = (M[j, 0, 0] * (M[j, 1, 1] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 1])
-           - M[j, 0, 1] * (M[j, 1, 0] * M[j, 2, 2] - M[j, 1, 2] * M[j, 2, 0])
-           + M[j, 0, 2] * (M[j, 1, 0] * M[j, 2, 1] - M[j, 1, 1] * M[j, 2, 0]))
+    # Relative, not the child's corners in (u, v): those differ by less than a rounding
+    # error on the slivers that grow along creases at the depths points there are taken to.
     for d in range(2):
-        u0, u1, u2 = uv[q, 0, d], uv[q, 1, d], uv[q, 2, d]
         for a in range(3):
-            a1, a2 = (a + 1) % 3, (a + 2) % 3
-            g0 = (M[j, a1, 1] * M[j, a2, 2] - M[j, a1, 2] * M[j, a2, 1]) / det
-            g1 = (M[j, a1, 2] * M[j, a2, 0] - M[j, a1, 0] * M[j, a2, 2]) / det
-            g2 = (M[j, a1, 0] * M[j, a2, 1] - M[j, a1, 1] * M[j, a2, 0]) / det
-            b[a] = g0 * u0 + g1 * u1 + g2 * u2
+            b[a] = M[j, a, 0] * grad[q, 0, d] + M[j, a, 1] * grad[q, 1, d] + M[j, a, 2] * grad[q, 2, d]
         for a in range(3):
-            uv[q, a, d] = b[a]
+            grad[q, a, d] = b[a]
     return j
 
 
-def _walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand_count, M, child, regular,
+def _walk_known(todo, level, state, keys, path, stop, bary, grad, cand_start, cand_count, M, child, regular,
                 stop_regular, depth):
     """The walk (``walk._descend``) of the points ``todo`` as far as the table knows the way.
 
     Point ``q`` is at ``level[q]`` on key ``keys[q, level[q]]`` (``state[q]`` 1: it has
     chosen ``path[q, level[q]]`` there, whose child patch was not cut yet). It goes down,
-    choosing a child per level (``_pick_one``), to ``depth`` or (with ``stop_regular``) to
+    choosing a child per level (``_pick_one``), to ``depth[q]`` or (with ``stop_regular``) to
     the first regular key, and then ``stop[q]`` is set and ``state[q]`` 0; or it halts at a
     key whose candidates are not known (``state[q]`` 2) or at a candidate whose child patch is
     not cut (``state[q]`` 1) for the caller to fill the table and call again. Threaded over
@@ -81,13 +74,13 @@ def _walk_known(todo, level, state, keys, path, stop, bary, uv, cand_start, cand
             state[q] = 0
             while True:
                 k = keys[q, lev]
-                if (stop_regular and regular[k] == 1) or lev == depth:
+                if (stop_regular and regular[k] == 1) or lev == depth[q]:
                     stop[q] = lev
                     break
                 if cand_start[k] < 0:
                     state[q] = 2
                     break
-                j = _pick_one(q, k, bary, uv, cand_start, cand_count, M, b)
+                j = _pick_one(q, k, bary, grad, cand_start, cand_count, M, b)
                 path[q, lev] = j
                 if child[j] < 0:
                     state[q] = 1
@@ -271,7 +264,7 @@ back_points, back_points_serial = threaded_and_serial(_back_points)
 
 
 @kernel
-def stencil_points(rec, bary, uv, inv, full, node, W):
+def stencil_points(rec, bary, grad, inv, full, node, W):
     """``descent.stencil_weights`` per point from a stencil record ``rec``: ``inv`` (s, 6, 6)
     the inverse of each record's interpolation matrix, ``full`` whether it is used (else
     linear), ``node`` (s, 9) the face's centroid (2), size (1) and corners (6). Fills ``W``
@@ -314,11 +307,8 @@ def stencil_points(rec, bary, uv, inv, full, node, W):
             for i in range(6):
                 w[i, 0] = 0.0
             w[top, 0] = 1.0
-        # J = ∂(s,t)/∂(u,v) = (e1 e2) (uv1 − uv0, uv2 − uv0)⁻¹
-        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
-        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
-        dt = a * d_ - b * c_
-        i00, i01, i10, i11 = d_ / dt, -b / dt, -c_ / dt, a / dt
+        # J = ∂(s,t)/∂(u,v) = (e1 e2) ∂(b1, b2)/∂(u, v)
+        i00, i01, i10, i11 = grad[q, 1, 0], grad[q, 1, 1], grad[q, 2, 0], grad[q, 2, 1]
         J[0, 0], J[0, 1] = e1s * i00 + e2s * i10, e1s * i01 + e2s * i11
         J[1, 0], J[1, 1] = e1t * i00 + e2t * i10, e1t * i01 + e2t * i11
         for i in range(6):
@@ -336,9 +326,9 @@ def stencil_points(rec, bary, uv, inv, full, node, W):
 
 
 @kernel
-def quartic_points(bary, uv, exps, coef, W):
+def quartic_points(bary, grad, exps, coef, W):
     """``regular.polynomial_weights``: the quartic Bernstein basis ``coef`` · b^``exps`` (15)
-    at every point and its derivatives in (u, v) (``uv`` (q, 3, 2) the face's corners), into
+    at every point and its derivatives in (u, v) (``grad`` (q, 3, 2) ∂b/∂(u, v)), into
     ``W`` (q, r, 15): value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v², the first r of them."""
     nr = W.shape[1]
     pw = np.zeros((3, 7))  # pw[c, p + 2] = b_c ** p, zero for p < 0
@@ -348,10 +338,7 @@ def quartic_points(bary, uv, exps, coef, W):
             pw[c, 2] = 1.0
             for p in range(1, 5):
                 pw[c, p + 2] = pw[c, p + 1] * bary[q, c]
-        a, b = uv[q, 1, 0] - uv[q, 0, 0], uv[q, 2, 0] - uv[q, 0, 0]
-        c_, d_ = uv[q, 1, 1] - uv[q, 0, 1], uv[q, 2, 1] - uv[q, 0, 1]
-        dt = a * d_ - b * c_
-        G[0, 0], G[0, 1], G[1, 0], G[1, 1] = d_ / dt, -b / dt, -c_ / dt, a / dt  # ∂(b1, b2)/∂(u, v)
+        G[0, 0], G[0, 1], G[1, 0], G[1, 1] = grad[q, 1, 0], grad[q, 1, 1], grad[q, 2, 0], grad[q, 2, 1]
         for t in range(15):
             i, j, k = exps[t, 0], exps[t, 1], exps[t, 2]
             f = coef[t]

@@ -70,11 +70,11 @@ def regular_torus(n: int = 6):
 GRID_INVERSE = np.linalg.inv(bernstein(GRID)[0])
 
 
-def polynomial_weights(bary: np.ndarray, uv: np.ndarray, n_rows: int) -> np.ndarray:
+def polynomial_weights(bary: np.ndarray, grad: np.ndarray, n_rows: int) -> np.ndarray:
     """Weights (q, n_rows, 15) on the 15 coefficients: value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v,
-    ∂²/∂v², from :func:`bernstein` and the face's corners in (u, v), ``uv`` (q, 3, 2)."""
+    ∂²/∂v², from :func:`bernstein` and the derivatives ``grad`` (q, 3, 2) of ``bary`` in (u, v)."""
     W = np.empty((len(bary), n_rows, 15))
-    quartic_points(np.ascontiguousarray(bary, dtype=np.float64), np.ascontiguousarray(uv, dtype=np.float64),
+    quartic_points(np.ascontiguousarray(bary, dtype=np.float64), np.ascontiguousarray(grad, dtype=np.float64),
                    EXPONENTS, _COEF, W)
     return W
 

@@ -9,6 +9,7 @@ import scipy.sparse as sp
 from ..._input import as_vertices, open_gate, writable
 from ..._typing import ArrayLike, LoopWeights, Scheme
 from .cache import PatchTable
+from .depth import PointDepths
 from .project import closest_points, seed_setup
 from .walk import StartKeys, walk_points, walk_rows
 
@@ -36,9 +37,10 @@ class LimitSurface:
         As for :func:`hybridsub.refine`; every scheme and tag.
     depth : int, optional
         Levels of exact local refinement before the last interpolation (default 24 for
-        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``: 1e-12 × the diagonal or better
-        at random points; in a narrow band round the hybrid's crease vertices, on their smooth
-        side, up to 5e-9 — see ``docs/limit.md``).
+        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``). Points next to irregular
+        vertices and next to split edges beside √3 faces are walked deeper, by a number of
+        levels that grows with the log of their distance (at most 56; a smaller ``depth``
+        shifts it down): 1e-12 × the diagonal or better everywhere (``docs/limit.md``).
 
     Notes
     -----
@@ -76,6 +78,7 @@ class LimitSurface:
             raise ValueError(f"depth must be a non-negative integer, got {depth!r}")
         self.depth = int(depth) + (int(depth) % 2 if scheme == "sqrt3" else 0)  # Kobbelt: even levels
         self._tol, self._max_levels = 1e-12, 60
+        self._depths = PointDepths(self._inp, _default_depth(scheme))
         self._new_cache()
 
     @property
@@ -121,7 +124,7 @@ class LimitSurface:
         self._starts = StartKeys(self._inp, self._table)
 
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
-        return walk_rows(self._table, self._starts, f, b, [1, 3, 6][int(derivatives)], depth)
+        return walk_rows(self._table, self._starts, f, b, [1, 3, 6][int(derivatives)], self._depths(f, b, depth))
 
     def evaluation_matrix(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False):
         """The sparse rows that give the limit surface at the points: ``evaluate == M @ V``.
@@ -197,7 +200,7 @@ class LimitSurface:
         n_rows = 3 if derivatives else 1
         X2 = writable(np.ascontiguousarray(X.reshape(len(X), -1)))
         parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
-                                                              self.depth, X2))
+                                                              self._depths(fc, bc, self.depth), X2))
         res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
         res = res.reshape((n_rows, len(f)) + X.shape[1:])
         return tuple(res) if derivatives else res[0]

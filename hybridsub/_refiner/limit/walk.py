@@ -40,9 +40,9 @@ from .descent import start
 from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
 
 
-def _corners(q: int) -> np.ndarray:
-    """The input face's corners in (u, v), for ``q`` points."""
-    return np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
+def _unit_gradients(q: int) -> np.ndarray:
+    """∂b/∂(u, v) (3, 2) on the input face, ``b = (1 − u − v, u, v)``, for ``q`` points."""
+    return np.repeat(np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])[None], q, axis=0)
 
 
 class StartKeys:
@@ -86,23 +86,26 @@ class StartKeys:
         return self.key[faces]
 
 
-def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool):
-    """Every point down to ``depth`` levels, or to the first regular Loop patch (with
-    ``stop_regular``). Returns the keys met (q, depth + 1), the candidates chosen (q, depth),
-    the level each point stopped at, and its barycentric coordinates and (u, v) corners there
-    (``bary``, ``uv`` updated in place). The walk goes as far as the table knows the way; keys
-    and child patches met for the first time are refined in a batch, and the walk goes on."""
+def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool):
+    """Every point down to its depth (``depth``, one per point or one for all), or to the
+    first regular Loop patch (with ``stop_regular``). Returns the keys met (q, max depth + 1),
+    the candidates chosen (q, max depth), the level each point stopped at, and its barycentric
+    coordinates there with their derivatives in (u, v) (``bary``, ``grad`` updated in place).
+    The walk goes as far as the table knows the way; keys and child patches met for the first
+    time are refined in a batch, and the walk goes on."""
     q = len(keys0)
-    keys = np.empty((q, depth + 1), np.int64)
-    path = np.empty((q, depth), np.int64)
-    stop = np.full(q, depth, np.int64)
+    depth = np.array(np.broadcast_to(depth, (q,)), np.int64)  # contiguous: the kernel's one type
+    top = int(depth.max()) if q else 0
+    keys = np.empty((q, top + 1), np.int64)
+    path = np.empty((q, top), np.int64)
+    stop = depth.copy()
     keys[:, 0] = keys0
     level = np.zeros(q, np.int64)
     state = np.zeros(q, np.int8)
     todo = np.arange(q)
     while len(todo):
         kernel = walk_known if use_threads(POINT_COST * len(todo)) else walk_known_serial
-        kernel(todo, level, state, keys, path, stop, bary, uv, table.cand_start.a, table.cand_count.a, table.M.a,
+        kernel(todo, level, state, keys, path, stop, bary, grad, table.cand_start.a, table.cand_count.a, table.M.a,
                table.child.a, table.regular.a, stop_regular, depth)
         todo = todo[state[todo] != 0]
         steps = todo[state[todo] == 2]
@@ -111,14 +114,14 @@ def _descend(table: PatchTable, keys0, bary, uv, depth: int, stop_regular: bool)
         cut = todo[state[todo] == 1]
         if len(cut):
             table.fill_children(np.unique(path[cut, level[cut]]))
-    return keys, path, stop, bary, uv
+    return keys, path, stop, bary, grad
 
 
-def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
+def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool):
     """The walk down (:func:`_descend`) and each point's weights on its last patch: the
     arguments of :func:`._walk_kernels.back_rows` before its output."""
     q = len(keys0)
-    keys, path, stop, bary, uv = _descend(table, keys0, bary.copy(), uv.copy(), depth, stop_regular)
+    keys, path, stop, bary, grad = _descend(table, keys0, bary.copy(), grad.copy(), depth, stop_regular)
     last = keys[np.arange(q), stop]
     poly = table.regular_keys(last) if stop_regular else np.zeros(q, bool)
     W = np.zeros((q, n_rows, 15))
@@ -127,7 +130,7 @@ def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, s
         uk = np.unique(last[poly])
         fill_polynomials(table, uk[table.poly.a[uk] < 0])
         block[poly] = table.poly.a[last[poly]]
-        W[poly] = polynomial_weights(bary[poly], uv[poly], n_rows)
+        W[poly] = polynomial_weights(bary[poly], grad[poly], n_rows)
     st = np.flatnonzero(~poly)
     if len(st):
         uk = np.unique(last[st])
@@ -136,7 +139,7 @@ def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, s
             table.fill_stencils(lack)
         rec = table.final.a[last[st]]
         Ws = np.empty((len(st), n_rows, 6))
-        stencil_points(rec, bary[st], uv[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
+        stencil_points(rec, bary[st], grad[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
         W[st, :, :6] = Ws
         block[st] = table.st_blk.a[rec]
     return (W, np.where(poly, 15, 6), block, stop, path, keys, table.nv.a, table.blk_v0.a, table.blk_c0.a,
@@ -144,10 +147,10 @@ def _last_weights(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, s
             table.t_col.a, table.t_val.a)
 
 
-def walk(table: PatchTable, keys0, bary, uv, n_rows: int, depth: int, stop_regular: bool):
+def walk(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool):
     """Rows (q, nv_max, n_rows) of the points over their first patches' canonical vertices:
     value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v²."""
-    args = _last_weights(table, keys0, bary, uv, n_rows, depth, stop_regular)
+    args = _last_weights(table, keys0, bary, grad, n_rows, depth, stop_regular)
     out = np.zeros((len(keys0), int(table.nv.a[keys0].max()) if len(keys0) else 0, n_rows))
     back_rows(*args, out)
     return out
@@ -159,7 +162,7 @@ def fill_polynomials(table: PatchTable, keys: np.ndarray):
     if not len(keys):
         return
     k = len(keys)
-    rows = walk(table, np.repeat(keys, 15), np.tile(GRID, (k, 1)), _corners(15 * k), 1, 2, False)[:, :, 0]
+    rows = walk(table, np.repeat(keys, 15), np.tile(GRID, (k, 1)), _unit_gradients(15 * k), 1, 2, False)[:, :, 0]
     coef = GRID_INVERSE @ rows.reshape(k, 15, -1)  # (k, 15, nv_max)
     nv = table.nv.a[keys]
     table.poly.a[keys] = table.add_blocks(np.concatenate([coef[i, :, :nv[i]].ravel() for i in range(k)]), 15, nv)
@@ -171,7 +174,7 @@ def _ring_rows(rings: np.ndarray, b: np.ndarray, n_rows: int, n: int) -> list:
     q = len(rings)
     ids = np.empty((q, 12), np.int64)
     vals = np.empty((n_rows, q, 12))
-    ring_rows(polynomial_weights(b, _corners(q), n_rows), ring_coefficients(), rings, ids, vals)
+    ring_rows(polynomial_weights(b, _unit_gradients(q), n_rows), ring_coefficients(), rings, ids, vals)
     indptr = np.arange(0, 12 * q + 1, 12)
     mats = []
     for r in range(n_rows):
@@ -182,11 +185,13 @@ def _ring_rows(rings: np.ndarray, b: np.ndarray, n_rows: int, n: int) -> list:
     return mats
 
 
-def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int):
-    """Rows over the control vertices of the points (face ``f``, bary ``b``): value, then
-    ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR
-    matrix). Points on regular input faces take the box spline directly."""
+def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth):
+    """Rows over the control vertices of the points (face ``f``, bary ``b``, walked to
+    ``depth``, one per point or one for all): value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v,
+    ∂²/∂v² (``n_rows`` of them, each a (q, n) CSR matrix). Points on regular input faces
+    take the box spline directly."""
     n = starts.inp.n_vertices
+    depth = np.broadcast_to(np.asarray(depth, np.int64), (len(f),))
     rings = starts.rings[f]
     fast = rings[:, 0] >= 0
     if fast.any():
@@ -194,12 +199,12 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
         where = np.empty(len(f), np.int64)  # each point's row in [rest; fast]
         where[rest] = np.arange(len(rest))
         where[fast] = len(rest) + np.arange(int(fast.sum()))
-        slow = walk_rows(table, starts, f[rest], b[rest], n_rows, depth) if len(rest) else [None] * n_rows
+        slow = walk_rows(table, starts, f[rest], b[rest], n_rows, depth[rest]) if len(rest) else [None] * n_rows
         quick = _ring_rows(rings[fast], b[fast], n_rows, n)
         return [sp.csr_matrix(sp.vstack([a, c] if a is not None else [c]))[where] for a, c in zip(slow, quick)]
     q = len(f)
     keys0 = starts.of(f)
-    out = walk(table, keys0, b, _corners(q), n_rows, depth, table.regular_stop)
+    out = walk(table, keys0, b, _unit_gradients(q), n_rows, depth, table.regular_stop)
     nv0 = table.nv.a[keys0]
     # Onto the control vertices: each point's first patch, by increasing vertex id.
     row, k = np.nonzero(np.arange(out.shape[1])[None, :] < nv0[:, None])
@@ -216,16 +221,17 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
     return mats
 
 
-def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int,
+def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth,
                 X: np.ndarray) -> np.ndarray:
     """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the walk's
     matrices, with the same bits."""
     res = np.zeros((n_rows, len(f), X.shape[1]))
+    depth = np.broadcast_to(np.asarray(depth, np.int64), (len(f),))
     rings = starts.rings[f]
     fast = rings[:, 0] >= 0
     if fast.any():
         part = np.zeros((n_rows, int(fast.sum()), X.shape[1]))
-        ring_points(polynomial_weights(b[fast], _corners(len(part[0])), n_rows), ring_coefficients(), rings[fast], X,
+        ring_points(polynomial_weights(b[fast], _unit_gradients(len(part[0])), n_rows), ring_coefficients(), rings[fast], X,
                     part)
         res[:, fast] = part
     rest = np.flatnonzero(~fast)
@@ -233,7 +239,8 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         keys0 = starts.of(f[rest])
         by_key = np.argsort(keys0, kind="stable")  # points on one patch together: the tables they read stay cached
         rest, keys0 = rest[by_key], keys0[by_key]
-        args = _last_weights(table, keys0, b[rest], _corners(len(rest)), n_rows, depth, table.regular_stop)
+        args = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
+                             table.regular_stop)
         part = np.zeros((n_rows, len(rest), X.shape[1]))
         kernel = back_points if use_threads(POINT_COST * len(rest)) else back_points_serial
         kernel(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
@@ -253,7 +260,7 @@ def ring_coefficients() -> np.ndarray:
     starts = StartKeys(inp, table)
     ring = starts.rings[0]
     keys0 = starts.of(np.zeros(15, np.int64))
-    out = walk(table, keys0, GRID.copy(), _corners(15), 1, 2, True)[:, :, 0]  # (15, nv): on the first patch
+    out = walk(table, keys0, GRID.copy(), _unit_gradients(15), 1, 2, True)[:, :, 0]  # (15, nv): on the first patch
     vids = starts.vids.a[starts.v0[0]:][:out.shape[1]]
     M = np.zeros((15, inp.n_vertices))
     M[:, vids] = out
