@@ -1,6 +1,7 @@
 """The limit surface anywhere (issue 14): LimitSurface.evaluate / evaluation_matrix / normals /
 project, and Refinement.vertex_origin."""
 
+import copy
 import pathlib
 
 import numpy as np
@@ -272,3 +273,17 @@ def test_points_next_to_irregular_vertices_and_creases_are_exact(name, mesh):
     P = s.evaluate(face, bary)
     Q = hybridsub.LimitSurface(V, F, depth=56, **kw).evaluate(face, bary)
     assert np.linalg.norm(P - Q, axis=1).max() < 1e-12 * _diag(V), name
+
+
+@pytest.mark.parametrize("name", ["hybrid-creases", "hybrid-sharp-faces", "sqrt3", "loop-creases"])
+def test_the_depth_rule_skips_only_points_it_would_leave_at_the_default(name):
+    """The cheap distance filter in front of the per-point depth rule changes no depth."""
+    V, F, kw = _feature_cases()[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    face, bary = _near_features(s, 3000, seed=11)
+    unfiltered = copy.copy(s._depths)
+    unfiltered.reach_vertex = unfiltered.reach_edge = np.inf
+    for depth in (s.depth - 6, s.depth, s.depth + 6):
+        d = s._depths(face, bary, depth)
+        assert np.array_equal(d, unfiltered(face, bary, depth)) and (d >= depth).all()
+        assert (d > depth).any()

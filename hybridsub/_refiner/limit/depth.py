@@ -101,14 +101,23 @@ class PointDepths:
                                np.where(_irregular_vertices(inp)[F], levels, -np.inf))
         self.halving = loop_face  # a level halves the face (Loop) instead of dividing it by √3
         self.any = self.edge.any(axis=1) | np.isfinite(self.vertex).any(axis=1)
+        # Beyond these distances no rule asks for more than the default (the loosest face type).
+        per_level = np.array([np.log(3.0) / 2, np.log(2.0)])[np.unique(loop_face).astype(int)]
+        vmax = self.vertex.max() if np.isfinite(self.vertex).any() else -np.inf
+        self.reach_vertex = float(np.exp(-(default - vmax) * per_level.min()))
+        self.reach_edge = float(np.exp(-(default - EDGE_LEVELS) * per_level.min())) if self.edge.any() else 0.0
 
     def __call__(self, f: np.ndarray, b: np.ndarray, depth: int) -> np.ndarray:
         """Depth of each point (face ``f``, bary ``b``) for a surface of depth ``depth``: the
         rule's depth shifted by ``depth`` − the scheme's default, between ``depth`` and
         ``max(depth, MAX_DEPTH)``."""
         out = np.full(len(f), depth, np.int64)
-        near = np.flatnonzero(self.any[f])
-        if not len(near) or depth >= MAX_DEPTH:
+        if depth >= MAX_DEPTH:
+            return out
+        # |p − corner i| ≥ (1 − b_i) × height and the distance to edge i is b_(i+2) × height.
+        near = np.flatnonzero(self.any[f] & ((b.max(axis=1) > 1 - self.reach_vertex / _HEIGHT)
+                                             | (b.min(axis=1) < self.reach_edge / _HEIGHT)))
+        if not len(near):
             return out
         fn, bn = f[near], b[near]
         per_level = np.where(self.halving[fn], np.log(2.0), np.log(3.0) / 2)  # log of 1 / the level's shrink
