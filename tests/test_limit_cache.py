@@ -231,7 +231,8 @@ def test_patches_joined_at_a_vertex_only(scheme):
 def test_evaluate_in_chunks_equals_the_matrix_bit_for_bit(mesh, monkeypatch):
     """evaluate (rows applied as they are carried back, regular faces straight from their
     rings) == evaluation_matrix @ V to the bit, in chunks with the cache emptied between
-    them, for 3-column, 1-D and empty data; the matrices hold no explicit zeros."""
+    them, for 3-column, 1-D and empty data; the matrices hold no explicit zeros. Derivatives
+    (applied to the data forward, where the rows cancel) agree to rounding."""
     import hybridsub._refiner.limit.surface as surface
 
     (V, F), kw = _regular_meshes(mesh)
@@ -243,8 +244,10 @@ def test_evaluate_in_chunks_equals_the_matrix_bit_for_bit(mesh, monkeypatch):
     assert (s._starts.rings[face, 0] >= 0).any() and (s._starts.rings[face, 0] < 0).any()  # both paths
     mats = s.evaluation_matrix(face, bary, derivatives=True)
     got = s.evaluate(face, bary, derivatives=True)
-    for M, P in zip(mats, got):
-        assert np.array_equal(M @ V, P) and (M.data != 0).all()
+    assert np.array_equal(mats[0] @ V, got[0])
+    for M, D in zip(mats[1:], got[1:]):
+        assert np.abs(M @ V - D).max() <= 1e-9 * np.abs(D).max()  # the rows lose ~1e-16 × 3^(depth/2)
+    assert all((M.data != 0).all() for M in mats)
     h = V[:, 2] - V[:, 0]  # per-vertex scalar data
     assert np.array_equal(s.evaluate(face, bary, vertices=h), mats[0] @ h)
     P0, Du0, Dv0 = s.evaluate(face[:0], bary[:0], derivatives=True)

@@ -118,7 +118,9 @@ def test_evaluation_matrix_is_what_evaluate_applies():
     for D in (Mu[:2], Mv[:2]):  # rows sum to 0 (not asked at the crease vertex: no tangent plane there)
         assert (np.abs(D.sum(axis=1)).A1 < 1e-9 * abs(D).sum(axis=1).A1).all()
     P, Du, Dv = s.evaluate(face, bary, derivatives=True)
-    assert np.array_equal(M @ V, P) and np.array_equal(Mu @ V, Du)
+    assert np.array_equal(M @ V, P)  # derivatives: applied to the data forward, where the rows lose digits
+    for D, G in ((Mu @ V, Du), (Mv @ V, Dv)):  # not at the crease vertex (no tangent plane: |Dv| ~ 4e3)
+        assert np.abs(D[:2] - G[:2]).max() <= 1e-9 * np.abs(G[:2]).max()
     # Other control positions through the same rows; the surface is affine invariant.
     V2 = 2.0 * V + [1.0, -2.0, 0.5]
     assert np.allclose(s.evaluate(face, bary, vertices=V2), 2.0 * P + [1.0, -2.0, 0.5], atol=1e-14)
@@ -287,3 +289,44 @@ def test_the_depth_rule_skips_only_points_it_would_leave_at_the_default(name):
         d = s._depths(face, bary, depth)
         assert np.array_equal(d, unfiltered(face, bary, depth)) and (d >= depth).all()
         assert (d > depth).any()
+
+
+@pytest.mark.parametrize("name", ["sqrt3", "hybrid-creases"])
+def test_derivatives_near_irregular_vertices_converge_with_depth(name):
+    """Derivatives at the depths points next to irregular vertices are walked to (up to 56):
+    applied to the data forward, they converge as the walk goes deeper; carried back as rows,
+    their weights grow like 3^(depth/2) and cancel, and went wrong by whole radians."""
+    V, F, kw = _feature_cases()[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    face, bary = _near_features(s, 300, seed=4)
+    deeper = hybridsub.LimitSurface(V, F, depth=s.depth + 8, **kw)
+    depth = s._depths(face, bary, s.depth)
+    assert ((depth > 32) & (depth <= 48)).any()
+    for D, E in zip(s.evaluate(face, bary, derivatives=True)[1:], deeper.evaluate(face, bary, derivatives=True)[1:]):
+        # Not at vertices (an irregular one has no derivative in the chart: it depends on the
+        # depth), nor next to the hybrid's crease vertices (no tangent plane).
+        # Where the second walk is 8 levels deeper (not cut at 56).
+        ok = (bary.max(axis=1) < 1 - 1e-14) & (np.linalg.norm(D, axis=1) > 1e-3 * _diag(V)) & (depth <= 48)
+        assert np.all(np.linalg.norm(D - E, axis=1)[ok] < 1e-6 * np.linalg.norm(E, axis=1)[ok])
+
+
+@pytest.mark.parametrize("name", ["sqrt3", "hybrid-creases"])
+def test_points_pushed_off_next_to_extraordinary_vertices_come_back(name):
+    """project near smooth vertices of valence ≠ 6 (10⁻⁶ … 10⁻¹ of a face away), where the
+    walk goes deep: its Newton steps need derivatives that keep their digits there."""
+    V, F, kw = _feature_cases()[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    rng = np.random.default_rng(3)
+    creased = np.zeros(len(V), bool)
+    creased[np.asarray(kw.get("sharp_edges", np.zeros((0, 2), int))).ravel()] = True
+    ev = np.flatnonzero((np.bincount(F.ravel(), minlength=len(V)) != 6) & ~creased)
+    v = rng.choice(ev, 60)
+    face = np.array([np.flatnonzero((F == x).any(axis=1))[0] for x in v])
+    corner = np.argmax(F[face] == v[:, None], axis=1)
+    r = 10.0 ** rng.uniform(-6, -1, 60)
+    bary = rng.dirichlet([1, 1, 1], 60) * r[:, None]
+    bary[np.arange(60), corner] += 1 - r
+    P, N = s.evaluate(face, bary), s.normals(face, bary)
+    d = 1e-3 * _diag(V)
+    _, _, Q, dist = s.project(P + d * N)
+    assert np.abs(Q - P).max() < 1e-9 * _diag(V) and np.abs(dist - d).max() < 1e-12 * _diag(V)

@@ -263,6 +263,75 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
 back_points, back_points_serial = threaded_and_serial(_back_points)
 
 
+@kernel(inline="always")
+def _forward_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                 t_end, t_row, t_col, t_val, base, vids, X, S, res, first):
+    """Rows ``first:`` of point ``q`` (derivatives: their weights sum to zero) applied to the
+    data ``X`` forward: the first patch's data, each step's, the last patch's slots ``S``, each
+    patch's data taken relative to its vertex 0, so that it keeps its precision however small
+    the patch (carried back, the rows' weights grow like the inverse of the last face's size
+    and cancel: a rounding error of 1e-16 becomes 1e-16 × 3^(depth/2))."""
+    nd = X.shape[1]
+    b = base[q]
+    c0 = vids[b]
+    for v in range(nv[keys[q, 0]]):
+        col = vids[b + v]
+        for k in range(nd):
+            buf[0, v, k] = X[col, k] - X[c0, k]
+    s = 0
+    for lev in range(stop[q]):
+        c = path[q, lev]
+        t = 1 - s
+        n1 = nv[keys[q, lev + 1]]
+        for v in range(n1):
+            for k in range(nd):
+                buf[t, v, k] = 0.0
+        for e in range(t_start[c], t_end[c]):
+            a, p, x = t_row[e], t_col[e], t_val[e]
+            for k in range(nd):
+                buf[t, a, k] += x * buf[s, p, k]
+        for k in range(nd):
+            o = buf[t, 0, k]
+            for v in range(n1):
+                buf[t, v, k] -= o
+        s = t
+    ns = slots[q]
+    for j in range(ns):
+        for k in range(nd):
+            S[j, k] = 0.0
+    bk = block[q]
+    for i in range(blk_nc[bk]):
+        v = blk_col[blk_c0[bk] + i]
+        off = blk_v0[bk] + i * ns
+        for j in range(ns):
+            x = blk_val[off + j]
+            for k in range(nd):
+                S[j, k] += x * buf[s, v, k]
+    for r in range(first, W.shape[1]):
+        for k in range(nd):
+            acc = 0.0
+            for j in range(ns):
+                acc += W[q, r, j] * S[j, k]
+            res[r, q, k] = acc
+
+
+def _forward_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
+                    t_row, t_col, t_val, base, vids, X, res, first):
+    """``res[first:]`` (r, q, d) of :func:`back_points` computed forward (:func:`_forward_one`):
+    the derivatives of ``evaluate``, exact to rounding at any depth. Threaded over tasks of
+    points (``forward_points``; ``forward_points_serial`` the same on one thread)."""
+    nmax = _largest(stop, keys, nv)
+    for task in prange((len(stop) + TASK - 1) // TASK):
+        buf = np.zeros((2, nmax, X.shape[1]))
+        S = np.zeros((W.shape[2], X.shape[1]))
+        for q in range(task * TASK, min(len(stop), (task + 1) * TASK)):
+            _forward_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
+                         t_start, t_end, t_row, t_col, t_val, base, vids, X, S, res, first)
+
+
+forward_points, forward_points_serial = threaded_and_serial(_forward_points)
+
+
 @kernel
 def stencil_points(rec, bary, grad, inv, full, node, W):
     """``descent.stencil_weights`` per point from a stencil record ``rec``: ``inv`` (s, 6, 6)

@@ -96,14 +96,13 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop):
         idx = np.flatnonzero(active)
         if not len(idx):
             break
-        M, *D = surface._matrix(face[idx], bary[idx], 2, depth)
-        P = M @ X
+        P, *D = surface._applied(face[idx], bary[idx], 6, depth, X)
         d = np.linalg.norm(pts[idx] - P, axis=1)
         better = d <= best_d[idx] * (1 + 1e-14)
         ib = idx[better]
         best_f[ib], best_b[ib], best_d[ib] = face[ib], bary[ib], d[better]
-        for j, Mj in enumerate(D):
-            G[ib, j] = (Mj @ X)[better]
+        for j, Dj in enumerate(D):
+            G[ib, j] = Dj[better]
         R[ib] = (pts[idx] - P)[better]
         trust[ib] = np.minimum(1.0, 2.0 * trust[ib])
         trust[idx[~better]] *= 0.25
@@ -129,7 +128,7 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     face, bary = _iterate(surface, X, many, sf[near].copy(), sb[near].copy(), min(COARSE_DEPTH, surface.depth),
                           max_iter, COARSE_STEP)
     # The best of each point's seeds goes on at the full depth.
-    d = np.linalg.norm(many - surface._matrix(face, bary, False, min(COARSE_DEPTH, surface.depth)) @ X, axis=1)
+    d = np.linalg.norm(many - surface._applied(face, bary, 1, min(COARSE_DEPTH, surface.depth), X)[0], axis=1)
     pick = np.arange(len(pts)) * k + np.argmin(d.reshape(len(pts), k), axis=1)
     face, bary = _iterate(surface, X, pts, face[pick], bary[pick], surface.depth, min(max_iter, FINE_ITER),
                           FINE_STEP)

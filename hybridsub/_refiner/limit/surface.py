@@ -174,7 +174,7 @@ class LimitSurface:
         for M in mats:
             M.sum_duplicates()
             M.sort_indices()
-        return tuple(mats) if derivatives else mats[0]  # derivatives=2 (project): second derivatives too
+        return tuple(mats) if derivatives else mats[0]
 
     def evaluate(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False, *,
                  vertices: ArrayLike | None = None):
@@ -198,12 +198,17 @@ class LimitSurface:
         X = self._data(vertices)
         f, b = self._points(face, bary)
         n_rows = 3 if derivatives else 1
-        X2 = writable(np.ascontiguousarray(X.reshape(len(X), -1)))
-        parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
-                                                              self._depths(fc, bc, self.depth), X2))
-        res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
+        res = self._applied(f, b, n_rows, self.depth, X.reshape(len(X), -1))
         res = res.reshape((n_rows, len(f)) + X.shape[1:])
         return tuple(res) if derivatives else res[0]
+
+    def _applied(self, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, X: np.ndarray) -> np.ndarray:
+        """The first ``n_rows`` of value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² applied to the
+        data ``X`` (n, d): (n_rows, k, d)."""
+        X2 = writable(np.ascontiguousarray(X, dtype=np.float64))
+        parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
+                                                              self._depths(fc, bc, depth), X2))
+        return np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
         """Unit normals ``∂P/∂u × ∂P/∂v`` (k, 3) (one-sided at creases: the given face's side).

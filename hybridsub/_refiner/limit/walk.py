@@ -24,6 +24,8 @@ from ._walk_kernels import (
     back_points,
     back_points_serial,
     back_rows,
+    forward_points,
+    forward_points_serial,
     regular_rings,
     ring_points,
     ring_rows,
@@ -31,13 +33,17 @@ from ._walk_kernels import (
     walk_known,
     walk_known_serial,
 )
+from .cache import Grow, PatchTable
+from .descent import start
+from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
 
 #: A point of the walk costs about what this many faces of a refinement step do (the
 #: threshold of the threaded kernels, ``_topology.use_threads``, counts faces).
 POINT_COST = 20
-from .cache import Grow, PatchTable
-from .descent import start
-from .regular import GRID, GRID_INVERSE, polynomial_weights, regular_torus
+#: Derivative rows carried back lose digits like the inverse of the last face's size (their
+#: weights grow so and cancel): past these levels (Loop faces, √3 faces), faces under 1e-6 of
+#: the input face's size, a point's derivatives are applied to the data forward instead.
+FORWARD_LEVELS = (20, 24)
 
 
 def _unit_gradients(q: int) -> np.ndarray:
@@ -224,7 +230,9 @@ def walk_rows(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray
 def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarray, n_rows: int, depth,
                 X: np.ndarray) -> np.ndarray:
     """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the walk's
-    matrices, with the same bits."""
+    matrices, with the same bits; the derivatives of points walked past ``FORWARD_LEVELS``
+    applied to the data forward instead (:func:`._walk_kernels.forward_points`), exact to
+    rounding where the rows lose digits."""
     res = np.zeros((n_rows, len(f), X.shape[1]))
     depth = np.broadcast_to(np.asarray(depth, np.int64), (len(f),))
     rings = starts.rings[f]
@@ -242,10 +250,27 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         args = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
                              table.regular_stop)
         part = np.zeros((n_rows, len(rest), X.shape[1]))
+        base = starts.v0[f[rest]]
         kernel = back_points if use_threads(POINT_COST * len(rest)) else back_points_serial
-        kernel(*args, starts.v0[f[rest]], starts.order.a, starts.vids.a, X, part)
+        kernel(*args, base, starts.order.a, starts.vids.a, X, part)  # evaluation_matrix(...) @ X, to the bit
+        if n_rows > 1:
+            _forward_derivatives(args, base, starts, np.asarray(starts.inp.face_sharp)[f[rest]], X, part)
         res[:, rest] = part
     return res
+
+
+def _forward_derivatives(args, base, starts: StartKeys, loop_face: np.ndarray, X: np.ndarray, part: np.ndarray):
+    """The derivatives of the points whose last faces are smaller than ``FORWARD_SIZE``
+    again, forward (:func:`._walk_kernels.forward_points`), into ``part[1:]``."""
+    W, slots, block, stop, path, keys, *tables = args
+    deep = np.flatnonzero(stop > np.where(loop_face, FORWARD_LEVELS[0], FORWARD_LEVELS[1]))
+    if not len(deep):
+        return
+    out = np.zeros((part.shape[0], len(deep), part.shape[2]))
+    kernel = forward_points if use_threads(POINT_COST * len(deep)) else forward_points_serial
+    kernel(W[deep], slots[deep], block[deep], stop[deep], path[deep], keys[deep], *tables, base[deep], starts.vids.a, X,
+           out, 1)
+    part[1:, deep] = out[1:]
 
 
 @functools.cache
