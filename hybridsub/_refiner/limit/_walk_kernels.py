@@ -204,7 +204,7 @@ def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk
 
 
 @kernel(inline="always")
-def _gather33(q, rows, b, n, order, vids, X, res):
+def _gather33(q, rows, b, n, order, vids, X, res, at):
     """The last loop of :func:`_back_points` for three rows of three-column data, its nine
     sums in registers (``res`` is zero on entry): the same additions in the same order."""
     s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
@@ -227,15 +227,16 @@ def _gather33(q, rows, b, n, order, vids, X, res):
             s20 += a * x0
             s21 += a * x1
             s22 += a * x2
-    res[0, q, 0], res[0, q, 1], res[0, q, 2] = s00, s01, s02
-    res[1, q, 0], res[1, q, 1], res[1, q, 2] = s10, s11, s12
-    res[2, q, 0], res[2, q, 1], res[2, q, 2] = s20, s21, s22
+    o = at[q]
+    res[0, o, 0], res[0, o, 1], res[0, o, 2] = s00, s01, s02
+    res[1, o, 0], res[1, o, 1], res[1, o, 2] = s10, s11, s12
+    res[2, o, 0], res[2, o, 1], res[2, o, 2] = s20, s21, s22
 
 
 def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
-                 t_row, t_col, t_val, base, order, vids, X, res):
-    """:func:`back_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
-    gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
+                 t_row, t_col, t_val, base, order, vids, X, res, at):
+    """:func:`back_rows` times the data ``X`` (n, d): ``res[:, at[q]]`` ((r, ·, d), zeroed by
+    the caller) gets ``R_r @ X`` for each point's rows ``R_r`` on the control vertices (its first patch's
     canonical vertex ``k`` is control vertex ``vids[base[q] + k]``; ``order[base[q]:]`` lists
     them by increasing id): the sums of the CSR product of ``walk.walk_rows``, term for term in
     its order (zeros left out, as there), so the same bits. Threaded over tasks of points
@@ -247,9 +248,10 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
             s = _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
                           t_start, t_end, t_row, t_col, t_val)
             if W.shape[1] == 3 and X.shape[1] == 3:
-                _gather33(q, buf[s], base[q], nv[keys[q, 0]], order, vids, X, res)
+                _gather33(q, buf[s], base[q], nv[keys[q, 0]], order, vids, X, res, at)
             else:
                 b = base[q]
+                o = at[q]
                 for k in range(nv[keys[q, 0]]):
                     loc = order[b + k]
                     col = vids[b + loc]
@@ -257,7 +259,7 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
                         a = buf[s, loc, r]
                         if a != 0.0:  # as walk_rows, which leaves zeros out of its matrices
                             for d in range(X.shape[1]):
-                                res[r, q, d] += a * X[col, d]
+                                res[r, o, d] += a * X[col, d]
 
 
 back_points, back_points_serial = threaded_and_serial(_back_points)
@@ -517,10 +519,10 @@ def ring_rows(W, C, rings, ids, vals):
 
 
 @kernel
-def ring_points(W, C, rings, X, res):
-    """:func:`ring_rows` times the data ``X`` (n, d): ``res`` (r, q, d), zeroed by the caller,
-    gets the sums of the CSR product of those rows (zeros left out), term for term in its
-    order."""
+def ring_points(W, C, rings, X, res, at):
+    """:func:`ring_rows` times the data ``X`` (n, d): ``res[:, at[q]]`` ((r, ·, d), zeroed by
+    the caller) gets the sums of the CSR product of those rows (zeros left out), term for term
+    in its order."""
     perm = np.empty(12, np.int64)
     val = np.empty((W.shape[1], 12))
     for q in range(len(rings)):
@@ -530,4 +532,4 @@ def ring_points(W, C, rings, X, res):
             for r in range(W.shape[1]):
                 if val[r, i] != 0.0:  # as walk._ring_rows, which leaves zeros out
                     for d in range(X.shape[1]):
-                        res[r, q, d] += val[r, i] * X[col, d]
+                        res[r, at[q], d] += val[r, i] * X[col, d]

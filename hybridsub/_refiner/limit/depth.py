@@ -115,8 +115,11 @@ class PointDepths:
         if depth >= MAX_DEPTH:
             return out
         # |p − corner i| ≥ (1 − b_i) × height and the distance to edge i is b_(i+2) × height.
-        near = np.flatnonzero(self.any[f] & ((b.max(axis=1) > 1 - self.reach_vertex / _HEIGHT)
-                                             | (b.min(axis=1) < self.reach_edge / _HEIGHT)))
+        b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+        close = np.maximum(np.maximum(b0, b1), b2) > 1 - self.reach_vertex / _HEIGHT
+        if self.reach_edge > 0:
+            close |= np.minimum(np.minimum(b0, b1), b2) < self.reach_edge / _HEIGHT
+        near = np.flatnonzero(close & self.any[f])
         if not len(near):
             return out
         fn, bn = f[near], b[near]

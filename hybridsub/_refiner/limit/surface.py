@@ -111,12 +111,17 @@ class LimitSurface:
         bad = np.flatnonzero((f < 0) | (f >= m))
         if len(bad):
             raise ValueError(f"face[{bad[0]}] = {f[bad[0]]} is not a face (the mesh has {m} faces)")
-        bad = np.flatnonzero(~np.isfinite(b).all(axis=1) | (b < -1e-9).any(axis=1) | (np.abs(b.sum(axis=1) - 1) > 1e-9))
+        b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+        total = b0 + b1 + b2  # not finite if a coordinate is not
+        low = np.minimum(np.minimum(b0, b1), b2)
+        bad = np.flatnonzero(~(np.abs(total - 1) <= 1e-9) | (low < -1e-9))
         if len(bad):
             raise ValueError(f"bary[{bad[0]}] = {b[bad[0]].tolist()} is not a point of its face: barycentric "
                              "coordinates must be >= 0 and sum to 1")
-        b = np.clip(b, 0.0, None)
-        return f, b / b.sum(axis=1, keepdims=True)
+        if (low < 0).any():
+            b = np.maximum(b, 0.0)
+            total = b[:, 0] + b[:, 1] + b[:, 2]
+        return f, b / total[:, None]
 
     def _new_cache(self):
         """An empty patch cache (``_refiner/limit/cache.py``): filled as points are evaluated."""

@@ -130,20 +130,22 @@ def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop
     keys, path, stop, bary, grad = _descend(table, keys0, bary.copy(), grad.copy(), depth, stop_regular)
     last = keys[np.arange(q), stop]
     poly = table.regular_keys(last) if stop_regular else np.zeros(q, bool)
-    W = np.zeros((q, n_rows, 15))
+    W = np.empty((q, n_rows, 15))  # the kernels read a point's first slots[q] weights only
     block = np.empty(q, np.int64)
     if poly.any():
-        uk = np.unique(last[poly])
-        fill_polynomials(table, uk[table.poly.a[uk] < 0])
-        block[poly] = table.poly.a[last[poly]]
+        lp = last[poly]
+        lack = lp[table.poly.a[lp] < 0]
+        if len(lack):
+            fill_polynomials(table, np.unique(lack))
+        block[poly] = table.poly.a[lp]
         W[poly] = polynomial_weights(bary[poly], grad[poly], n_rows)
     st = np.flatnonzero(~poly)
     if len(st):
-        uk = np.unique(last[st])
-        lack = uk[table.final.a[uk] < 0]
+        ls = last[st]
+        lack = ls[table.final.a[ls] < 0]
         if len(lack):
-            table.fill_stencils(lack)
-        rec = table.final.a[last[st]]
+            table.fill_stencils(np.unique(lack))
+        rec = table.final.a[ls]
         Ws = np.empty((len(st), n_rows, 6))
         stencil_points(rec, bary[st], grad[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
         W[st, :, :6] = Ws
@@ -235,13 +237,11 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
     rounding where the rows lose digits."""
     res = np.zeros((n_rows, len(f), X.shape[1]))
     depth = np.broadcast_to(np.asarray(depth, np.int64), (len(f),))
-    rings = starts.rings[f]
-    fast = rings[:, 0] >= 0
-    if fast.any():
-        part = np.zeros((n_rows, int(fast.sum()), X.shape[1]))
-        ring_points(polynomial_weights(b[fast], _unit_gradients(len(part[0])), n_rows), ring_coefficients(), rings[fast], X,
-                    part)
-        res[:, fast] = part
+    fast = starts.rings[f, 0] >= 0
+    on = np.flatnonzero(fast)
+    if len(on):
+        ring_points(polynomial_weights(b[on], _unit_gradients(len(on)), n_rows), ring_coefficients(), starts.rings[f[on]],
+                    X, res, on)
     rest = np.flatnonzero(~fast)
     if len(rest):
         keys0 = starts.of(f[rest])
@@ -249,28 +249,27 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         rest, keys0 = rest[by_key], keys0[by_key]
         args = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
                              table.regular_stop)
-        part = np.zeros((n_rows, len(rest), X.shape[1]))
         base = starts.v0[f[rest]]
         kernel = back_points if use_threads(POINT_COST * len(rest)) else back_points_serial
-        kernel(*args, base, starts.order.a, starts.vids.a, X, part)  # evaluation_matrix(...) @ X, to the bit
+        kernel(*args, base, starts.order.a, starts.vids.a, X, res, rest)  # evaluation_matrix(...) @ X, to the bit
         if n_rows > 1:
-            _forward_derivatives(args, base, starts, np.asarray(starts.inp.face_sharp)[f[rest]], X, part)
-        res[:, rest] = part
+            _forward_derivatives(args, base, starts, np.asarray(starts.inp.face_sharp)[f[rest]], X, res, rest)
     return res
 
 
-def _forward_derivatives(args, base, starts: StartKeys, loop_face: np.ndarray, X: np.ndarray, part: np.ndarray):
-    """The derivatives of the points whose last faces are smaller than ``FORWARD_SIZE``
-    again, forward (:func:`._walk_kernels.forward_points`), into ``part[1:]``."""
+def _forward_derivatives(args, base, starts: StartKeys, loop_face: np.ndarray, X: np.ndarray, res: np.ndarray,
+                         at: np.ndarray):
+    """The derivatives of the points walked past ``FORWARD_LEVELS`` again, forward
+    (:func:`._walk_kernels.forward_points`), into ``res[1:, at]``."""
     W, slots, block, stop, path, keys, *tables = args
     deep = np.flatnonzero(stop > np.where(loop_face, FORWARD_LEVELS[0], FORWARD_LEVELS[1]))
     if not len(deep):
         return
-    out = np.zeros((part.shape[0], len(deep), part.shape[2]))
+    out = np.zeros((res.shape[0], len(deep), res.shape[2]))
     kernel = forward_points if use_threads(POINT_COST * len(deep)) else forward_points_serial
     kernel(W[deep], slots[deep], block[deep], stop[deep], path[deep], keys[deep], *tables, base[deep], starts.vids.a, X,
            out, 1)
-    part[1:, deep] = out[1:]
+    res[1:, at[deep]] = out[1:]
 
 
 @functools.cache
