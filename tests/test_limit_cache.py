@@ -55,9 +55,10 @@ def test_a_shared_cache_gives_what_a_fresh_one_gives():
     warm.evaluate(*_points(F, 80, seed=2), derivatives=True)  # fills the cache with other points
     n_before = warm._table.n_keys
     got = warm.evaluate(face, bary, derivatives=True)
-    fresh = hybridsub.LimitSurface(V, F, depth=8, **kw).evaluate(face, bary, derivatives=True)
-    assert warm._table.n_keys < n_before + 40 * 8  # keys were found again
-    for a, b, tol in zip(got, fresh, (1e-13, 1e-12, 1e-12)):  # derivatives: the representatives' shapes
+    new = hybridsub.LimitSurface(V, F, depth=8, **kw)
+    fresh = new.evaluate(face, bary, derivatives=True)
+    assert warm._table.n_keys - n_before < new._table.n_keys  # some keys were found again
+    for a, b, tol in zip(got, fresh, (1e-13, 1e-9, 1e-9)):  # derivatives: the representatives' shapes (1e-9 grid)
         assert np.abs(a - b).max() <= tol * np.abs(b).max()
     again = warm.evaluate(face, bary, derivatives=True)  # every key known: same bits
     for a, b in zip(got, again):
@@ -86,7 +87,7 @@ def test_renumbered_rotated_and_mirrored_copies_give_the_same_surface(scheme):
     assert np.abs(Q - (P * [-1, 1, 1] + [5, 0, 0])).max() < 1e-13
     alone = hybridsub.LimitSurface(V, F, scheme=scheme, depth=8, **kw).evaluate(face, bary)
     assert np.abs(alone - P).max() < 1e-13
-    assert s._table.n_keys < 2 * 8 * 50  # keys repeat
+    assert s._table.n_keys < 2 * s._depths(*s._points(face, bary), s.depth).sum()  # keys repeat (visits: 2 copies)
 
 
 def test_keys_repeat_in_regular_regions():

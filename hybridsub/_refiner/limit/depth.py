@@ -36,9 +36,10 @@ EDGE_LEVELS = 16
 GRADED_VERTEX_LEVELS = 22
 SQRT3_VERTEX_LEVELS = 12
 LOOP_VERTEX_LEVELS = 4
-#: Levels past the default for a point exactly on a split edge beside a √3 face: it stays in
-#: the faces along the edge, which converge (measured: 2e-11 → 2e-14 of the diagonal).
-ON_EDGE_LEVELS = 8
+#: Depth of a point exactly on a split edge beside a √3 face: it stays in the faces along the
+#: edge, which converge (measured: between a sharp and a smooth face 2e-11 of the diagonal at
+#: 24 levels, 5e-12 at 26, 3e-14 at 32; on a boundary 8.5e-13 from 18 to 36, 4e-14 at 40).
+ON_EDGE_DEPTH = 40
 #: No point goes deeper than this (unless ``depth`` itself is deeper): √3 faces are then
 #: 3^(−28) ≈ 4e-14 of the input face's size, about where the chart's rounding starts to show.
 MAX_DEPTH = 56
@@ -136,7 +137,7 @@ class PointDepths:
                 r = np.linalg.norm(p - _CORNER[i], axis=1)
                 near_vertex = np.isfinite(self.vertex[fn, i]) & (r > 0)
                 need = np.where(near_vertex, np.maximum(need, self.vertex[fn, i] - np.log(r) / per_level), need)
-        need = np.where(on_edge, np.maximum(np.minimum(need, MAX_DEPTH), self.default + ON_EDGE_LEVELS),
+        need = np.where(on_edge, np.maximum(np.minimum(need, MAX_DEPTH), ON_EDGE_DEPTH),
                         np.minimum(need, MAX_DEPTH))
         d = np.clip(np.ceil(need).astype(np.int64) + (depth - self.default), depth, MAX_DEPTH)
         d[bn.max(axis=1) >= 1 - VERTEX] = depth  # the last level's vertex: its limit position, exactly

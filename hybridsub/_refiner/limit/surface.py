@@ -21,7 +21,7 @@ CACHE_BYTES = 2**29
 
 def _default_depth(scheme: str) -> int:
     # Chart size after the descent: 3^(-depth/2) for √3 faces, 2^(-depth) for Loop faces.
-    return {"loop": 14, "sqrt3": 18}.get(scheme, 24)
+    return 14 if scheme == "loop" else 18
 
 
 class LimitSurface:
@@ -36,8 +36,8 @@ class LimitSurface:
     sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
         As for :func:`hybridsub.refine`; every scheme and tag.
     depth : int, optional
-        Levels of exact local refinement before the last interpolation (default 24 for
-        ``"hybrid"``, 18 for ``"sqrt3"``, 14 for ``"loop"``). Points next to irregular
+        Levels of exact local refinement before the last interpolation (default 18 for
+        ``"hybrid"`` and ``"sqrt3"``, 14 for ``"loop"``). Points next to irregular
         vertices and next to split edges beside √3 faces are walked deeper, by a number of
         levels that grows with the log of their distance (at most 56; a smaller ``depth``
         shifts it down): 1e-12 × the diagonal or better everywhere (``docs/limit.md``).
