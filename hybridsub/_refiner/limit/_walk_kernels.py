@@ -138,6 +138,21 @@ def _back3(buf, s, t, e, end, t_row, t_col, t_val):
 
 
 @kernel(inline="always")
+def _back1(buf, s, t, e, end, t_row, t_col, t_val):
+    """:func:`_back_any` for one row (the value): the same sums."""
+    while e < end:
+        a = t_row[e]
+        r0 = buf[s, a, 0]
+        if r0 != 0.0:
+            while e < end and t_row[e] == a:
+                buf[t, t_col[e], 0] += r0 * t_val[e]
+                e += 1
+        else:
+            while e < end and t_row[e] == a:
+                e += 1
+
+
+@kernel(inline="always")
 def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
               t_row, t_col, t_val):
     """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``."""
@@ -167,6 +182,8 @@ def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk
         end = t_end[c]
         if nr == 3:
             _back3(buf, s, t, e, end, t_row, t_col, t_val)
+        elif nr == 1:
+            _back1(buf, s, t, e, end, t_row, t_col, t_val)
         else:
             _back_any(buf, s, t, e, end, t_row, t_col, t_val)
         s = t
