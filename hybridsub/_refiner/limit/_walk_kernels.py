@@ -140,7 +140,9 @@ def _back3(buf, s, t, e, end, t_row, t_col, t_val):
 @kernel(inline="always")
 def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end,
               t_row, t_col, t_val):
-    """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``."""
+    """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``
+    (any number of rows; one and three have their own loops, :func:`_back_value` and
+    :func:`_back_three`, with the same sums)."""
     nr = W.shape[1]
     d = stop[q]
     s = 0
@@ -163,12 +165,7 @@ def _back_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk
         for v in range(nv[keys[q, lev]]):
             for r in range(nr):
                 buf[t, v, r] = 0.0
-        e = t_start[c]
-        end = t_end[c]
-        if nr == 3:
-            _back3(buf, s, t, e, end, t_row, t_col, t_val)
-        else:
-            _back_any(buf, s, t, e, end, t_row, t_col, t_val)
+        _back_any(buf, s, t, t_start[c], t_end[c], t_row, t_col, t_val)
         s = t
     return s
 
@@ -212,6 +209,41 @@ def _back_value(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, b
 
 
 @kernel(inline="always")
+def _back_three(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
+                t_end, t_row, t_col, t_val):
+    """:func:`_back_one` for three rows (value, ∂/∂u, ∂/∂v), its loops written for them: the
+    same sums."""
+    d = stop[q]
+    ns = slots[q]
+    for v in range(nv[keys[q, d]]):
+        buf[0, v, 0] = 0.0
+        buf[0, v, 1] = 0.0
+        buf[0, v, 2] = 0.0
+    b = block[q]
+    for k in range(blk_nc[b]):
+        off = blk_v0[b] + k * ns
+        a0 = a1 = a2 = 0.0
+        for j in range(ns):
+            x = blk_val[off + j]
+            a0 += W[q, 0, j] * x
+            a1 += W[q, 1, j] * x
+            a2 += W[q, 2, j] * x
+        v = blk_col[blk_c0[b] + k]
+        buf[0, v, 0], buf[0, v, 1], buf[0, v, 2] = a0, a1, a2
+    s = 0
+    for lev in range(d - 1, -1, -1):
+        c = path[q, lev]
+        t = 1 - s
+        for v in range(nv[keys[q, lev]]):
+            buf[t, v, 0] = 0.0
+            buf[t, v, 1] = 0.0
+            buf[t, v, 2] = 0.0
+        _back3(buf, s, t, t_start[c], t_end[c], t_row, t_col, t_val)
+        s = t
+    return s
+
+
+@kernel(inline="always")
 def _largest(stop, keys, nv):
     """The largest patch the points meet (vertices): the room a point's rows need."""
     nmax = 0
@@ -234,7 +266,10 @@ def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk
     """
     buf = np.zeros((2, _largest(stop, keys, nv), W.shape[1]))  # this level's rows and the next's
     for q in range(len(stop)):
-        if W.shape[1] == 1:
+        if W.shape[1] == 3:
+            s = _back_three(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
+                            t_start, t_end, t_row, t_col, t_val)
+        elif W.shape[1] == 1:
             s = _back_value(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
                             t_start, t_end, t_row, t_col, t_val)
         else:
@@ -287,7 +322,10 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
     for task in prange((len(stop) + TASK - 1) // TASK):
         buf = np.zeros((2, nmax, W.shape[1]))  # this level's rows and the next's
         for q in range(task * TASK, min(len(stop), (task + 1) * TASK)):
-            if W.shape[1] == 1:
+            if W.shape[1] == 3:
+                s = _back_three(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
+                                t_start, t_end, t_row, t_col, t_val)
+            elif W.shape[1] == 1:
                 s = _back_value(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val,
                                 t_start, t_end, t_row, t_col, t_val)
             else:
