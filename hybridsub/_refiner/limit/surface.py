@@ -129,7 +129,7 @@ class LimitSurface:
         self._starts = StartKeys(self._inp, self._table)
 
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
-        return walk_rows(self._table, self._starts, f, b, [1, 3, 6][int(derivatives)], self._depths(f, b, depth))
+        return walk_rows(self._table, self._starts, f, b, 3 if derivatives else 1, self._depths(f, b, depth))
 
     def evaluation_matrix(self, face: ArrayLike, bary: ArrayLike, derivatives: bool = False):
         """The sparse rows that give the limit surface at the points: ``evaluate == M @ V``.
@@ -147,7 +147,11 @@ class LimitSurface:
         -------
         M : scipy.sparse.csr_matrix, (k, n)
             Or ``(M, Mu, Mv)`` with ``derivatives=True``. Rows of ``M`` sum to 1, those of
-            ``Mu``, ``Mv`` to 0; they depend on the connectivity and tags only.
+            ``Mu``, ``Mv`` to 0; they depend on the connectivity and tags only. ``M @ V`` is
+            ``evaluate``'s value to the bit; its derivatives agree with ``Mu @ V``, ``Mv @ V``
+            to the rows' rounding, which grows like 3^(depth/2): past 24 levels (points next
+            to irregular vertices and creases) ``evaluate`` applies them to the data instead,
+            keeping their digits (``docs/limit.md``).
 
         Examples
         --------
@@ -173,7 +177,7 @@ class LimitSurface:
 
     def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         chunks = self._chunks(f, b, lambda fc, bc: self._rows(fc, bc, derivatives, depth))
-        parts = list(zip(*chunks)) or [()] * [1, 3, 6][int(derivatives)]
+        parts = list(zip(*chunks)) or [()] * (3 if derivatives else 1)
         n = self._inp.n_vertices
         mats = [a[0] if len(a) == 1 else sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
         for M in mats:
