@@ -8,11 +8,11 @@ import dataclasses
 import numpy as np
 
 from ..._input import RefineInput
+from ..._topology import build_level
 from ..chart import onto_input_faces
 from ..refinement import refinement_of
 from .api import LimitSetup, _evaluate
 from .plan import edge_sharpness
-from ..._topology import build_level
 
 #: Levels of the refined mesh whose limit points seed the search.
 SEED_LEVELS = 2

@@ -21,12 +21,14 @@ import scipy.sparse as sp
 
 from ..._input import RefineInput, open_gate
 from ..._topology import use_threads
-from ._walk_kernels import (
+from ._carry_kernels import (
     back_points,
     back_points_serial,
     back_rows,
     forward_points,
     forward_points_serial,
+)
+from ._walk_kernels import (
     regular_rings,
     ring_points,
     ring_rows,
@@ -133,7 +135,7 @@ def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool):
 
 def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool):
     """The walk down (:func:`_descend`) and each point's weights on its last patch: the
-    arguments of :func:`._walk_kernels.back_rows` before its output."""
+    arguments of :func:`._carry_kernels.back_rows` before its output."""
     q = len(keys0)
     keys, path, stop, bary, grad = _descend(table, keys0, bary.copy(), grad.copy(), depth, stop_regular)
     last = keys[np.arange(q), stop]
@@ -241,7 +243,7 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
                 X: np.ndarray) -> np.ndarray:
     """``[R @ X for R in walk_rows(...)]`` (n_rows, q, d) without forming the walk's
     matrices, with the same bits; the derivatives of points walked past ``FORWARD_LEVELS``
-    applied to the data forward instead (:func:`._walk_kernels.forward_points`), exact to
+    applied to the data forward instead (:func:`._carry_kernels.forward_points`), exact to
     rounding where the rows lose digits."""
     res = np.zeros((n_rows, len(f), X.shape[1]))
     depth = np.broadcast_to(np.asarray(depth, np.int64), (len(f),))
@@ -268,7 +270,7 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
 def _forward_derivatives(args, base, starts: StartKeys, loop_face: np.ndarray, X: np.ndarray, res: np.ndarray,
                          at: np.ndarray):
     """The derivatives of the points walked past ``FORWARD_LEVELS`` again, forward
-    (:func:`._walk_kernels.forward_points`), into ``res[1:, at]``."""
+    (:func:`._carry_kernels.forward_points`), into ``res[1:, at]``."""
     W, slots, block, stop, path, keys, *tables = args
     deep = np.flatnonzero(stop > np.where(loop_face, FORWARD_LEVELS[0], FORWARD_LEVELS[1]))
     if not len(deep):
