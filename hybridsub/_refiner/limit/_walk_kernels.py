@@ -14,6 +14,9 @@ from ..._jit import kernel, threaded_and_serial
 
 #: Candidates whose smallest barycentric coordinates differ by less are a tie.
 TIE = 1e-14
+#: A point whose smallest barycentric coordinate in a candidate is above this is inside it,
+#: and no later candidate can be chosen (the children tile the patch: theirs are <= 0).
+INSIDE = 1e-9
 #: Points per task of the threaded kernels (each point is independent of the others).
 TASK = 64
 
@@ -39,6 +42,8 @@ def _pick_one(q, k, bary, grad, cand_start, cand_count, M, b):
             best = lo
             chosen = j
             nb0, nb1, nb2 = b[0], b[1], b[2]
+            if lo > INSIDE:  # inside this child: the others, which tile round it, have lo <= 0
+                break
     j = chosen
     bary[q, 0], bary[q, 1], bary[q, 2] = nb0, nb1, nb2
     # Relative, not the child's corners in (u, v): those differ by less than a rounding
