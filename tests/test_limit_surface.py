@@ -330,3 +330,9 @@ def test_points_pushed_off_next_to_extraordinary_vertices_come_back(name):
     d = 1e-3 * _diag(V)
     _, _, Q, dist = s.project(P + d * N)
     assert np.abs(Q - P).max() < 1e-9 * _diag(V) and np.abs(dist - d).max() < 1e-12 * _diag(V)
+
+
+def test_a_mesh_without_faces_has_an_empty_surface():
+    s = hybridsub.LimitSurface(np.zeros((3, 3)), np.zeros((0, 3), int))
+    P, Du, Dv = s.evaluate(np.zeros(0, int), np.zeros((0, 3)), derivatives=True)
+    assert P.shape == Du.shape == (0, 3) and s.evaluation_matrix(np.zeros(0, int), np.zeros((0, 3))).shape == (0, 3)

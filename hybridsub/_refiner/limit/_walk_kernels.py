@@ -17,6 +17,9 @@ TIE = 1e-14
 #: A point whose smallest barycentric coordinate in a candidate is above this is inside it,
 #: and no later candidate can be chosen (the children tile the patch: theirs are <= 0).
 INSIDE = 1e-9
+#: A point whose largest barycentric coordinate is this close to 1 is that vertex: the last
+#: interpolation gives it the vertex's limit position exactly.
+AT_VERTEX = 1e-14
 #: Points per task of the threaded kernels (each point is independent of the others).
 TASK = 64
 
@@ -137,7 +140,7 @@ def stencil_points(rec, bary, grad, inv, full, node, W):
         for c in range(1, 3):
             if bary[q, c] > bary[q, top]:
                 top = c
-        if bary[q, top] >= 1.0 - 1e-14:  # at a vertex: its limit position exactly
+        if bary[q, top] >= 1.0 - AT_VERTEX:  # at a vertex: its limit position exactly
             for i in range(6):
                 w[i, 0] = 0.0
             w[top, 0] = 1.0

@@ -21,7 +21,7 @@ limit surface is smooth over a few such faces, and is not in two places, at any 
 
 Measured on fandisk (creases, a sharp/smooth interface, vertices of valence 3 to 9) and an
 open patch (Kobbelt's boundary), against the same points at depth 56, points at distances
-10⁻¹ … 10⁻¹² (``docs/limit.md``, "Accuracy"). Points closer than ``VERTEX`` to a vertex
+10⁻¹ … 10⁻¹² (``docs/limit.md``, "Accuracy"). Points closer than ``AT_VERTEX`` to a vertex
 take its limit position, exactly; points exactly on a split edge converge along it.
 """
 
@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._input import RefineInput
+from ._walk_kernels import AT_VERTEX
 
 #: Levels past the one where the faces' size equals the distance (see the module docstring).
 EDGE_LEVELS = 16
@@ -43,8 +44,6 @@ ON_EDGE_DEPTH = 40
 #: No point goes deeper than this (unless ``depth`` itself is deeper): √3 faces are then
 #: 3^(−28) ≈ 4e-14 of the input face's size, about where the chart's rounding starts to show.
 MAX_DEPTH = 56
-#: A point this close to a corner (barycentric) is that vertex (as ``stencil_points`` takes it).
-VERTEX = 1e-14
 
 _CORNER = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, np.sqrt(3.0) / 2]])
 _HEIGHT = np.sqrt(3.0) / 2
@@ -103,10 +102,10 @@ class PointDepths:
         self.halving = loop_face  # a level halves the face (Loop) instead of dividing it by √3
         self.any = self.edge.any(axis=1) | np.isfinite(self.vertex).any(axis=1)
         # Beyond these distances no rule asks for more than the default (the loosest face type).
-        per_level = np.array([np.log(3.0) / 2, np.log(2.0)])[np.unique(loop_face).astype(int)]
+        per_level = np.log(2.0) if loop_face.size and loop_face.all() else np.log(3.0) / 2
         vmax = self.vertex.max() if np.isfinite(self.vertex).any() else -np.inf
-        self.reach_vertex = float(np.exp(-(default - vmax) * per_level.min()))
-        self.reach_edge = float(np.exp(-(default - EDGE_LEVELS) * per_level.min())) if self.edge.any() else 0.0
+        self.reach_vertex = float(np.exp(-(default - vmax) * per_level))
+        self.reach_edge = float(np.exp(-(default - EDGE_LEVELS) * per_level)) if self.edge.any() else 0.0
 
     def __call__(self, f: np.ndarray, b: np.ndarray, depth: int) -> np.ndarray:
         """Depth of each point (face ``f``, bary ``b``) for a surface of depth ``depth``: the
@@ -140,7 +139,7 @@ class PointDepths:
         need = np.where(on_edge, np.maximum(np.minimum(need, MAX_DEPTH), ON_EDGE_DEPTH),
                         np.minimum(need, MAX_DEPTH))
         d = np.clip(np.ceil(need).astype(np.int64) + (depth - self.default), depth, MAX_DEPTH)
-        d[bn.max(axis=1) >= 1 - VERTEX] = depth  # the last level's vertex: its limit position, exactly
+        d[bn.max(axis=1) >= 1 - AT_VERTEX] = depth  # the last level's vertex: its limit position, exactly
         if self.sqrt3:
             d += d % 2  # Kobbelt's boundary: even levels
         out[near] = d

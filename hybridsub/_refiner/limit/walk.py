@@ -260,26 +260,36 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         args = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
                              table.regular_stop)
         base = starts.v0[f[rest]]
-        kernel = back_points if _threaded(len(rest)) else back_points_serial
-        kernel(*args, base, starts.order.a, starts.vids.a, X, res, rest)  # evaluation_matrix(...) @ X, to the bit
+        stop = args[3]
+        deep = np.zeros(len(rest), bool)
         if n_rows > 1:
-            _forward_derivatives(args, base, starts, np.asarray(starts.inp.face_sharp)[f[rest]], X, res, rest)
+            deep = stop > np.where(np.asarray(starts.inp.face_sharp)[f[rest]], *FORWARD_LEVELS)
+        if not deep.any():
+            _carry_back(args, base, starts, X, res, rest)  # evaluation_matrix(...) @ X, to the bit
+            return res
+        shallow, deep = np.flatnonzero(~deep), np.flatnonzero(deep)
+        if len(shallow):
+            _carry_back(_points_of(args, shallow), base[shallow], starts, X, res, rest[shallow])
+        W, *per_point = _points_of(args, deep)
+        value = (np.ascontiguousarray(W[:, :1]), *per_point)
+        _carry_back(value, base[deep], starts, X, res, rest[deep])  # the value alone: its rows' bits
+        out = np.zeros((n_rows, len(deep), X.shape[1]))
+        kernel = forward_points if _threaded(len(deep)) else forward_points_serial
+        kernel(W, *per_point, base[deep], starts.vids.a, X, out, 1)
+        res[1:, rest[deep]] = out[1:]
     return res
 
 
-def _forward_derivatives(args, base, starts: StartKeys, loop_face: np.ndarray, X: np.ndarray, res: np.ndarray,
-                         at: np.ndarray):
-    """The derivatives of the points walked past ``FORWARD_LEVELS`` again, forward
-    (:func:`._carry_kernels.forward_points`), into ``res[1:, at]``."""
-    W, slots, block, stop, path, keys, *tables = args
-    deep = np.flatnonzero(stop > np.where(loop_face, FORWARD_LEVELS[0], FORWARD_LEVELS[1]))
-    if not len(deep):
-        return
-    out = np.zeros((res.shape[0], len(deep), res.shape[2]))
-    kernel = forward_points if _threaded(len(deep)) else forward_points_serial
-    kernel(W[deep], slots[deep], block[deep], stop[deep], path[deep], keys[deep], *tables, base[deep], starts.vids.a, X,
-           out, 1)
-    res[1:, at[deep]] = out[1:]
+def _points_of(args, idx: np.ndarray) -> tuple:
+    """:func:`_last_weights`' output for the points ``idx`` (its first six are per point)."""
+    return tuple(a[idx] for a in args[:6]) + tuple(args[6:])
+
+
+def _carry_back(args, base, starts: StartKeys, X: np.ndarray, res: np.ndarray, at: np.ndarray):
+    """The rows of :func:`_last_weights`' ``args`` carried back and applied to ``X`` into
+    ``res[:, at]`` (:func:`._carry_kernels.back_points`)."""
+    kernel = back_points if _threaded(len(at)) else back_points_serial
+    kernel(*args, base, starts.order.a, starts.vids.a, X, res, at)
 
 
 @functools.cache
