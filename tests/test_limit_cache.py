@@ -100,6 +100,44 @@ def test_keys_repeat_in_regular_regions():
     assert s._table.n_keys < 200 * 10 / 4
 
 
+def _stored_transitions(t):
+    """Each stored transition's contents (bytes) → the first entries holding them."""
+    out = {}
+    for a, b in {(int(a), int(b)) for a, b in zip(t.t_start.a, t.t_end.a) if b > a}:
+        key = t.t_row.a[a:b].tobytes() + t.t_col.a[a:b].tobytes() + t.t_val.a[a:b].tobytes()
+        out.setdefault(key, set()).add(a)
+    return out
+
+
+@pytest.mark.parametrize("collide", [False, True])
+def test_transitions_are_stored_once_per_content(collide, monkeypatch):
+    """Patches that differ in shape alone share their step's rows: the table holds each
+    distinct transition once, and only what candidates point at. With every content hash
+    made equal nothing is shared wrongly (reuse is checked entry for entry): the surface is
+    the same to the bit."""
+    V, F, kw = CASES["hybrid-crease"]
+    face, bary = _points(F, 300, seed=11)
+    ref = hybridsub.LimitSurface(V, F, depth=10, **kw).evaluate(face, bary, derivatives=True)
+    if collide:
+        from hybridsub._refiner.limit import cache
+        monkeypatch.setattr(cache, "_segment_hashes", lambda row, col, val, bounds: np.zeros((len(bounds) - 1, 2),
+                                                                                              np.uint64))
+    s = hybridsub.LimitSurface(V, F, depth=10, **kw)
+    got = s.evaluate(face, bary, derivatives=True)
+    for a, b in zip(got, ref):
+        assert np.array_equal(a, b)
+    t = s._table
+    stored = _stored_transitions(t)
+    if not collide:  # (colliding, a content whose hash is taken by another is stored again)
+        assert all(len(at) == 1 for at in stored.values())  # no content twice
+    live = t.t_end.a > t.t_start.a
+    first, at = np.unique(t.t_start.a[live], return_index=True)
+    used = int((t.t_end.a[live][at] - first).sum())
+    assert len(t.t_val.a) == used  # nothing stored that no candidate points at
+    n_cands = int(live.sum())
+    assert collide or len(stored) < n_cands / 2  # on this mesh, most candidates share their rows
+
+
 def _torus(n=6, seed=6):
     """A closed n × n torus grid, every vertex of valence 6 (regular Loop everywhere), jittered."""
     V, F = regular_torus(n)

@@ -109,8 +109,16 @@ class PatchTable:
         self.scheme, self.loop_weights = scheme, loop_weights
         self.tol, self.max_levels = tol, max_levels
         self.index: dict[tuple, int] = {}  # key hash → key id
-        self.reps: list[tuple] = []  # per key: F, twin, hsharp, face_sharp, corner, shape (canonical)
-        self.parity: list[int] = []  # per key: 1 when the next step is odd ("sqrt3" only)
+        # The representatives, canonical, one after another: key k's faces rep_f0[k]:+rep_nf[k]
+        # (corners, twins, sharpness of its halfedges from rep_h0[k] if any, else −1, Loop
+        # faces, shapes), its vertices rep_v0[k]:+nv[k] (corner tags).
+        self.rep_f0, self.rep_nf = Grow((), np.int64), Grow((), np.int64)
+        self.rep_v0, self.rep_h0 = Grow((), np.int64), Grow((), np.int64)
+        self.rep_F, self.rep_twin = Grow((3,), np.int32), Grow((3,), np.int32)
+        self.rep_hs = Grow((3,))
+        self.rep_fs, self.rep_corner = Grow((), np.bool_), Grow((), np.bool_)
+        self.rep_shape = Grow((3, 2))
+        self.parity = Grow((), np.int8)  # per key: 1 when the next step is odd ("sqrt3" only)
         self.nv = Grow((), np.int64)
         self.cand_start = Grow((), np.int64, -1)  # per key (−1: not refined yet)
         self.cand_count = Grow((), np.int64)
@@ -141,17 +149,30 @@ class PatchTable:
         self.st_full = Grow((), np.bool_)
         self.st_inv = Grow((6, 6))  # the inverse of the interpolation matrix
         self._recent = None
-        self._rep_bytes = 0
+        self._t_index: dict[tuple, int] = {}  # a transition's contents (hash, length) → its first entry
 
     @property
     def nbytes(self) -> int:
         """What the cache holds, roughly (the representatives estimated)."""
         grown = sum(g.a.nbytes for g in vars(self).values() if isinstance(g, Grow))
-        return grown + self._rep_bytes + 120 * len(self.index)
+        return grown + 120 * (len(self.index) + len(self._t_index))
 
     @property
     def n_keys(self) -> int:
-        return len(self.reps)
+        return self.nv.n
+
+    @property
+    def reps(self) -> list[tuple]:
+        """The representatives as ``(F, twin, hsharp or None, face_sharp, corner, shape)`` per
+        key (for inspection; the tables keep them flat)."""
+        out = []
+        for k in range(self.n_keys):
+            f = slice(self.rep_f0.a[k], self.rep_f0.a[k] + self.rep_nf.a[k])
+            h0 = self.rep_h0.a[k]
+            hs = None if h0 < 0 else self.rep_hs.a[h0:h0 + self.rep_nf.a[k]].ravel()
+            out.append((self.rep_F.a[f], self.rep_twin.a[f].ravel(), hs, self.rep_fs.a[f],
+                        self.rep_corner.a[self.rep_v0.a[k]:][:self.nv.a[k]], self.rep_shape.a[f]))
+        return out
 
     def register(self, level, corner, shape, centre, fstart, parity):
         """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
@@ -163,26 +184,44 @@ class PatchTable:
         reg = np.empty(len(centre), np.int8)
         regular_flags(rec, fstart, cv, vstart, reg)
         ids = np.empty(len(centre), np.int64)
+        new = []
         for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):
             kid = self.index.get(key)
             if kid is None:
-                kid = self.index[key] = len(self.reps)
-                a, b, va, vb = fstart[i], fstart[i + 1], vstart[i], vstart[i + 1]
-                hk = rec[a:b, 7:10].ravel().view(np.float64)  # the halfedges' sharpness, rotated
-                self.reps.append((rec[a:b, :3].astype(np.int32), rec[a:b, 3:6].ravel().astype(np.int32),
-                                  hk if hk.any() else None, level.face_sharp[fperm[a:b]], cv[va:vb].copy(),
-                                  norm[a:b].copy()))
-                self._rep_bytes += 400 + 90 * (b - a)
-                self.parity.append(parity)
-                self.regular.append([reg[i]])
+                kid = self.index[key] = self.n_keys + len(new)
+                new.append(i)
             ids[i] = kid
+        if new:
+            self._add_representatives(np.array(new), rec, fstart, fperm, level.face_sharp, cv, vstart, norm)
+            self.parity.append(np.full(len(new), parity))
+            self.regular.append(reg[new])
         n = self.n_keys
         for g in (self.cand_start, self.final, self.poly):
             g.extend_to(n)
         self.cand_count.extend_to(n)
-        if self.nv.n < n:
-            self.nv.append([len(self.reps[j][4]) for j in range(self.nv.n, n)])
         return ids, vperm, vstart
+
+    def _add_representatives(self, new, rec, fstart, fperm, face_sharp, cv, vstart, norm):
+        """The pieces ``new`` of a batch (:meth:`register`'s arrays) become the representatives
+        of the next keys, in order."""
+        nf = fstart[new + 1] - fstart[new]
+        nv = vstart[new + 1] - vstart[new]
+        f = _ranges(fstart[new], nf)
+        hs = np.ascontiguousarray(rec[f, 7:10]).view(np.float64)  # the halfedges' sharpness, rotated
+        sharp = np.add.reduceat((hs != 0).any(axis=1), np.concatenate([[0], np.cumsum(nf)[:-1]])) > 0
+        self.rep_f0.append(self.rep_F.n + np.concatenate([[0], np.cumsum(nf)[:-1]]))
+        self.rep_nf.append(nf)
+        self.rep_v0.append(self.rep_corner.n + np.concatenate([[0], np.cumsum(nv)[:-1]]))
+        h0 = np.full(len(new), -1, np.int64)
+        h0[sharp] = self.rep_hs.n + np.concatenate([[0], np.cumsum(nf[sharp])[:-1]])
+        self.rep_h0.append(h0)
+        self.rep_hs.append(hs[_ranges(np.concatenate([[0], np.cumsum(nf)[:-1]])[sharp], nf[sharp])])
+        self.rep_F.append(rec[f, :3])
+        self.rep_twin.append(rec[f, 3:6])
+        self.rep_fs.append(face_sharp[fperm[f]])
+        self.rep_shape.append(norm[f])
+        self.rep_corner.append(cv[_ranges(vstart[new], nv)])
+        self.nv.append(nv)
 
     def regular_keys(self, keys: np.ndarray) -> np.ndarray:
         """Whether each key is a regular Loop patch (:func:`.regular.is_regular`)."""
@@ -191,25 +230,31 @@ class PatchTable:
     def patches(self, keys: np.ndarray):
         """The representatives of ``keys`` as one mesh of disjoint pieces; also the face and
         vertex offsets of each piece (its centre is its first face)."""
-        reps = [self.reps[k] for k in keys]
-        nf = np.array([len(r[0]) for r in reps], np.int64)
-        nv = np.array([len(r[4]) for r in reps], np.int64)
+        keys = np.asarray(keys, np.int64)
+        nf, nv = self.rep_nf.a[keys], self.nv.a[keys]
         foff = np.concatenate([[0], np.cumsum(nf)])
         voff = np.concatenate([[0], np.cumsum(nv)])
-        F = np.concatenate([r[0] for r in reps]).astype(np.int64) + np.repeat(voff[:-1], nf)[:, None]
-        tw = np.concatenate([r[1] for r in reps]).astype(np.int64)
-        tw = np.where(tw >= 0, tw + 3 * np.repeat(foff[:-1], 3 * nf), -1)
-        hs = np.concatenate([np.zeros(3 * len(r[0])) if r[2] is None else r[2] for r in reps])
-        level = Level(F, int(voff[-1]), tw, hs if hs.any() else None, np.concatenate([r[3] for r in reps]))
+        f = _ranges(self.rep_f0.a[keys], nf)
+        F = self.rep_F.a[f].astype(np.int64) + np.repeat(voff[:-1], nf)[:, None]
+        tw = self.rep_twin.a[f].astype(np.int64)
+        tw = np.where(tw >= 0, tw + 3 * np.repeat(foff[:-1], nf)[:, None], -1).ravel()
+        h0 = self.rep_h0.a[keys]
+        sharp = h0 >= 0
+        hs = None
+        if sharp.any():
+            hs = np.zeros((len(f), 3))
+            hs[_ranges(foff[:-1][sharp], nf[sharp])] = self.rep_hs.a[_ranges(h0[sharp], nf[sharp])]
+            hs = hs.ravel()
+        level = Level(F, int(voff[-1]), tw, hs, self.rep_fs.a[f])
         uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(keys), axis=0)
-        p = Patches(level, np.concatenate([r[4] for r in reps]), np.concatenate([r[5] for r in reps]),
+        p = Patches(level, self.rep_corner.a[_ranges(self.rep_v0.a[keys], nv)], self.rep_shape.a[f],
                     foff[:-1].copy(), uv)
         return p, foff, voff
 
     def _refine(self, keys: np.ndarray):
         """One step of the representatives of ``keys`` (all of one parity)."""
         p, _, voff = self.patches(keys)
-        plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, self.scheme, 2 - self.parity[keys[0]],
+        plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, self.scheme, 2 - int(self.parity.a[keys[0]]),
                                                                        self.loop_weights)
         return {"keys": keys, "p": p, "voff": voff, "plan": plan, "S": S.tocsr(), "faces1": faces1, "child": child,
                 "shapes_of": shapes_of, "cid": cid, "ccorn": ccorn}
@@ -217,7 +262,7 @@ class PatchTable:
     def _refined(self, keys: np.ndarray):
         """:meth:`_refine` per parity; the last result is kept for :meth:`fill_children`."""
         out = []
-        par = np.array([self.parity[k] for k in keys])
+        par = self.parity.a[keys]
         for b in np.unique(par):
             out.append(self._refine(keys[par == b]))
         self._recent = out
@@ -259,7 +304,7 @@ class PatchTable:
         centre = r["cid"][node, self.slot.a[cands]]
         nxt, corner_n, shape_n, cur, vsel, fstart = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
                                                                  r["shapes_of"], centre)
-        parity = self.parity[owners[0]] ^ 1 if self.scheme == "sqrt3" else 0
+        parity = int(self.parity.a[owners[0]]) ^ 1 if self.scheme == "sqrt3" else 0
         kids, vperm, vstart = self.register(nxt, corner_n, shape_n, cur, fstart, parity)
         T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order
         # Columns: the parent piece's vertices (canonical: the representative's own order).
@@ -267,12 +312,49 @@ class PatchTable:
         col = T.col - r["voff"][node[row_node]]
         row = T.row - vstart[row_node]
         bounds = np.searchsorted(row_node, np.arange(len(centre) + 1))
-        base = self.t_row.append(row)
-        self.t_col.append(col)
-        self.t_val.append(T.data)
-        self.t_start.a[cands] = base + bounds[:-1]
-        self.t_end.a[cands] = base + bounds[1:]
+        self._add_transitions(cands, row.astype(np.int32), col.astype(np.int32), T.data, bounds)
         self.child.a[cands] = kids
+
+    def _add_transitions(self, cands, row, col, val, bounds):
+        """Store candidate ``cands[i]``'s transition, entries ``bounds[i]:bounds[i + 1]`` of
+        ``row``, ``col``, ``val``, once per distinct content: patches that differ in shape
+        alone (most keys beside creases, and every input face's in a regular region) share
+        their step's rows, so the table holds each once (a fifth of the entries on fandisk's
+        hybrid) and the carry reads fewer distinct ones."""
+        h = _segment_hashes(row, col, val, bounds)
+        n = np.diff(bounds)
+        start = np.full(len(cands), -1, np.int64)  # where each one's entries are stored
+        copy = np.full(len(cands), -1, np.int64)  # or the one of this batch it repeats
+        first: dict[tuple, int] = {}
+        keys = list(zip(h[:, 0].tolist(), h[:, 1].tolist(), n.tolist()))
+        for i, key in enumerate(keys):
+            known = self._t_index.get(key)
+            if known is not None:
+                start[i] = known
+            elif key in first:
+                copy[i] = first[key]
+            else:
+                first[key] = i
+        # A hash is not taken on trust: what is reused must be equal entry for entry.
+        old = np.flatnonzero(start >= 0)
+        same = _same_segments((row, col, val), bounds[old], (self.t_row.a, self.t_col.a, self.t_val.a), start[old], n[old])
+        start[old[~same]] = -1
+        dup = np.flatnonzero(copy >= 0)
+        same = _same_segments((row, col, val), bounds[dup], (row, col, val), bounds[copy[dup]], n[dup])
+        copy[dup[~same]] = -1
+        own = np.flatnonzero((start < 0) & (copy < 0))
+        keep = _ranges(bounds[own], n[own])
+        base = self.t_row.append(row[keep])
+        self.t_col.append(col[keep])
+        self.t_val.append(val[keep])
+        start[own] = base + np.concatenate([[0], np.cumsum(n[own])[:-1]])
+        for i in first.values():
+            if start[i] >= 0:
+                self._t_index[keys[i]] = int(start[i])
+        dup = np.flatnonzero(copy >= 0)
+        start[dup] = start[copy[dup]]
+        self.t_start.a[cands] = start
+        self.t_end.a[cands] = start + n
 
     def fill_stencils(self, keys: np.ndarray):
         """The last interpolation's data of ``keys`` (unique, none yet): stencil vertices, their
@@ -318,6 +400,47 @@ class PatchTable:
         self.blk_col.append(col)
         self.blk_val.append(vals.ravel())
         return ids
+
+
+def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """``concatenate([arange(s, s + n) for s, n in zip(starts, lengths)])``."""
+    offs = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    return np.repeat(starts - offs, lengths) + np.arange(int(lengths.sum()))
+
+
+def _same_segments(mine, at, theirs, their_at, lengths) -> np.ndarray:
+    """Whether each segment of the arrays ``mine`` from ``at`` equals that of ``theirs`` from
+    ``their_at`` (``lengths`` entries each), bit for bit."""
+    if not len(lengths):
+        return np.ones(0, bool)
+    a, b = _ranges(at, lengths), _ranges(their_at, lengths)
+    eq = np.ones(len(a), bool)
+    for x, y in zip(mine, theirs):
+        eq &= x[a].view(np.int64 if x.itemsize == 8 else np.int32) == y[b].view(np.int64 if y.itemsize == 8 else np.int32)
+    live = lengths > 0
+    out = np.ones(len(lengths), bool)
+    out[live] = np.logical_and.reduceat(eq, np.concatenate([[0], np.cumsum(lengths)[:-1]])[live])
+    return out
+
+
+def _segment_hashes(row, col, val, bounds) -> np.ndarray:
+    """Two 64-bit hashes (k, 2) of each segment ``bounds[i]:bounds[i + 1]`` of the entries:
+    every entry mixed with its place in its segment (splitmix64's finaliser), summed."""
+    n = np.diff(bounds)
+    place = (np.arange(len(row)) - np.repeat(bounds[:-1], n)).astype(np.uint64)
+    out = np.zeros((len(n), 2), np.uint64)
+    with np.errstate(over="ignore"):
+        for j, salt in enumerate((np.uint64(0x9E3779B97F4A7C15), np.uint64(0xD1B54A32D192ED03))):
+            x = (row.astype(np.uint64) << np.uint64(32)) ^ col.astype(np.uint64)
+            x = x * salt ^ val.view(np.uint64) ^ (place + np.uint64(1)) * np.uint64(0xBF58476D1CE4E5B9)
+            x ^= x >> np.uint64(30)
+            x *= np.uint64(0xBF58476D1CE4E5B9)
+            x ^= x >> np.uint64(27)
+            x *= np.uint64(0x94D049BB133111EB) + salt
+            x ^= x >> np.uint64(31)
+            live = n > 0
+            out[live, j] = np.add.reduceat(x, bounds[:-1][live]) if len(x) else 0
+    return out
 
 
 def _sorted(a: np.ndarray) -> bool:
