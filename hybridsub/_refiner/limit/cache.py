@@ -16,7 +16,8 @@ walk needs is kept in flat tables:
   map ``M`` of the point's barycentric coordinates into the child's (its inverse transposed
   holds the child's corners over the centre face, to follow (u, v)) and, once a point has
   chosen it, the child's key and the step's rows restricted to (child patch × patch)
-  vertices ``T``;
+  vertices ``T`` (stored once per distinct content: they depend on the connectivity and tags
+  alone, so keys that differ in shape share them);
 - per key ending a descent, the interpolation stencil's six vertices with their exact limit
   rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
 
