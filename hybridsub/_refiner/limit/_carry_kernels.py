@@ -14,6 +14,8 @@ from numba import prange
 from ..._jit import kernel, threaded_and_serial
 from ._walk_kernels import TASK
 
+_U0, _U1 = np.uintp(0), np.uintp(1)
+
 
 @kernel(inline="always")
 def _back_any(buf, s, t, e, end, t_row, t_col, t_val):
@@ -40,23 +42,32 @@ def _back_any(buf, s, t, e, end, t_row, t_col, t_val):
 
 @kernel(inline="always")
 def _back3(buf, s, t, e, end, t_row, t_col, t_val):
-    """:func:`_back_any` for three rows (value, ∂/∂u, ∂/∂v) held in registers: the same sums."""
-    while e < end:
-        a = t_row[e]
-        r0 = buf[s, a, 0]
-        r1 = buf[s, a, 1]
-        r2 = buf[s, a, 2]
+    """:func:`_back_any` for three rows (value, ∂/∂u, ∂/∂v) held in registers: the same sums.
+    Unsigned indices, as in :func:`_back_value`."""
+    src = buf[s]
+    dst = buf[t]
+    rows = t_row[e:end]
+    cols = t_col[e:end]
+    vals = t_val[e:end]
+    n = np.uintp(len(rows))
+    i = _U0
+    while i < n:
+        a = rows[i]
+        ua = np.uintp(a)
+        r0 = src[ua, 0]
+        r1 = src[ua, 1]
+        r2 = src[ua, 2]
         if r0 != 0.0 or r1 != 0.0 or r2 != 0.0:
-            while e < end and t_row[e] == a:
-                x = t_val[e]
-                b = t_col[e]
-                buf[t, b, 0] += r0 * x
-                buf[t, b, 1] += r1 * x
-                buf[t, b, 2] += r2 * x
-                e += 1
+            while i < n and rows[i] == a:
+                x = vals[i]
+                b = np.uintp(cols[i])
+                dst[b, 0] += r0 * x
+                dst[b, 1] += r1 * x
+                dst[b, 2] += r2 * x
+                i += _U1
         else:
-            while e < end and t_row[e] == a:
-                e += 1
+            while i < n and rows[i] == a:
+                i += _U1
 
 
 @kernel(inline="always")
@@ -111,20 +122,27 @@ def _back_value(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, b
     for lev in range(d - 1, -1, -1):
         c = path[q, lev]
         t = 1 - s
+        src = buf[s, :, 0]
+        dst = buf[t, :, 0]
         for v in range(nv[keys[q, lev]]):
-            buf[t, v, 0] = 0.0
-        e = t_start[c]
-        end = t_end[c]
-        while e < end:
-            a = t_row[e]
-            r0 = buf[s, a, 0]
+            dst[v] = 0.0
+        rows = t_row[t_start[c]:t_end[c]]
+        cols = t_col[t_start[c]:t_end[c]]
+        vals = t_val[t_start[c]:t_end[c]]
+        n = np.uintp(len(rows))
+        e = _U0
+        # Unsigned indices: a signed one costs each access Numba's negative-index test (a
+        # third of this loop's time).
+        while e < n:
+            a = rows[e]
+            r0 = src[np.uintp(a)]
             if r0 != 0.0:
-                while e < end and t_row[e] == a:
-                    buf[t, t_col[e], 0] += r0 * t_val[e]
-                    e += 1
+                while e < n and rows[e] == a:
+                    dst[np.uintp(cols[e])] += r0 * vals[e]
+                    e += _U1
             else:
-                while e < end and t_row[e] == a:
-                    e += 1
+                while e < n and rows[e] == a:
+                    e += _U1
         s = t
     return s
 
