@@ -154,7 +154,7 @@ class PatchTable:
 
     @property
     def nbytes(self) -> int:
-        """What the cache holds, roughly (the representatives estimated)."""
+        """What the cache holds (its two dictionaries estimated)."""
         grown = sum(g.a.nbytes for g in vars(self).values() if isinstance(g, Grow))
         return grown + 120 * (len(self.index) + len(self._t_index))
 
@@ -338,7 +338,8 @@ class PatchTable:
                 first[key] = i
         # A hash is not taken on trust: what is reused must be equal entry for entry.
         old = np.flatnonzero(start >= 0)
-        same = _same_segments((row, col, val), bounds[old], (self.t_row.a, self.t_col.a, self.t_val.a), start[old], n[old])
+        stored = (self.t_row.a, self.t_col.a, self.t_val.a)
+        same = _same_segments((row, col, val), bounds[old], stored, start[old], n[old])
         start[old[~same]] = -1
         dup = np.flatnonzero(copy >= 0)
         same = _same_segments((row, col, val), bounds[dup], (row, col, val), bounds[copy[dup]], n[dup])
@@ -417,7 +418,8 @@ def _same_segments(mine, at, theirs, their_at, lengths) -> np.ndarray:
     a, b = _ranges(at, lengths), _ranges(their_at, lengths)
     eq = np.ones(len(a), bool)
     for x, y in zip(mine, theirs):
-        eq &= x[a].view(np.int64 if x.itemsize == 8 else np.int32) == y[b].view(np.int64 if y.itemsize == 8 else np.int32)
+        bits = np.int64 if x.itemsize == 8 else np.int32  # floats by their bits: -0.0 is not 0.0
+        eq &= x[a].view(bits) == y[b].view(bits)
     live = lengths > 0
     out = np.ones(len(lengths), bool)
     out[live] = np.logical_and.reduceat(eq, np.concatenate([[0], np.cumsum(lengths)[:-1]])[live])
