@@ -22,22 +22,27 @@ def _back_any(buf, s, t, e, end, t_row, t_col, t_val):
     """``buf[t] += T^T buf[s]`` over the entries ``e:end`` of one transition, by rows: rows
     whose sums are all zero are skipped."""
     nr = buf.shape[2]
+    src = buf[s]
+    dst = buf[t]
+    e = np.uintp(e)  # unsigned indices, as in _back_value
+    end = np.uintp(end)
     while e < end:
         a = t_row[e]
+        ua = np.uintp(a)
         live = False
         for r in range(nr):
-            if buf[s, a, r] != 0.0:
+            if src[ua, r] != 0.0:
                 live = True
         if live:
             while e < end and t_row[e] == a:
                 x = t_val[e]
-                b = t_col[e]
+                b = np.uintp(t_col[e])
                 for r in range(nr):
-                    buf[t, b, r] += buf[s, a, r] * x
-                e += 1
+                    dst[b, r] += src[ua, r] * x
+                e += _U1
         else:
             while e < end and t_row[e] == a:
-                e += 1
+                e += _U1
 
 
 @kernel(inline="always")
@@ -313,10 +318,15 @@ def _forward_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, 
         for v in range(n1):
             for k in range(nd):
                 buf[t, v, k] = 0.0
-        for e in range(t_start[c], t_end[c]):
-            a, p, x = t_row[e], t_col[e], t_val[e]
+        src = buf[s]
+        dst = buf[t]
+        e = np.uintp(t_start[c])
+        end = np.uintp(t_end[c])
+        while e < end:  # unsigned indices, as in _back_value
+            a, p, x = np.uintp(t_row[e]), np.uintp(t_col[e]), t_val[e]
             for k in range(nd):
-                buf[t, a, k] += x * buf[s, p, k]
+                dst[a, k] += x * src[p, k]
+            e += _U1
         for k in range(nd):
             o = buf[t, 0, k]
             for v in range(n1):
