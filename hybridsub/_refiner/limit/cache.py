@@ -150,13 +150,14 @@ class PatchTable:
         self.st_full = Grow((), np.bool_)
         self.st_inv = Grow((6, 6))  # the inverse of the interpolation matrix
         self._recent = None
-        self._t_index: dict[tuple, int] = {}  # a transition's contents (hash, length) → its first entry
+        self._t_index: dict[bytes, int] = {}  # a transition's contents → its first entry
+        self._t_key_bytes = 0
 
     @property
     def nbytes(self) -> int:
         """What the cache holds (its two dictionaries estimated)."""
         grown = sum(g.a.nbytes for g in vars(self).values() if isinstance(g, Grow))
-        return grown + 120 * (len(self.index) + len(self._t_index))
+        return grown + 120 * (len(self.index) + len(self._t_index)) + self._t_key_bytes
 
     @property
     def n_keys(self) -> int:
@@ -208,15 +209,16 @@ class PatchTable:
         nf = fstart[new + 1] - fstart[new]
         nv = vstart[new + 1] - vstart[new]
         f = _ranges(fstart[new], nf)
+        f0 = _firsts(nf)  # each piece's first face among f
         hs = np.ascontiguousarray(rec[f, 7:10]).view(np.float64)  # the halfedges' sharpness, rotated
-        sharp = np.add.reduceat((hs != 0).any(axis=1), np.concatenate([[0], np.cumsum(nf)[:-1]])) > 0
-        self.rep_f0.append(self.rep_F.n + np.concatenate([[0], np.cumsum(nf)[:-1]]))
+        sharp = np.add.reduceat((hs != 0).any(axis=1), f0) > 0
+        self.rep_f0.append(self.rep_F.n + f0)
         self.rep_nf.append(nf)
-        self.rep_v0.append(self.rep_corner.n + np.concatenate([[0], np.cumsum(nv)[:-1]]))
+        self.rep_v0.append(self.rep_corner.n + _firsts(nv))
         h0 = np.full(len(new), -1, np.int64)
-        h0[sharp] = self.rep_hs.n + np.concatenate([[0], np.cumsum(nf[sharp])[:-1]])
+        h0[sharp] = self.rep_hs.n + _firsts(nf[sharp])
         self.rep_h0.append(h0)
-        self.rep_hs.append(hs[_ranges(np.concatenate([[0], np.cumsum(nf)[:-1]])[sharp], nf[sharp])])
+        self.rep_hs.append(hs[_ranges(f0[sharp], nf[sharp])])
         self.rep_F.append(rec[f, :3])
         self.rep_twin.append(rec[f, 3:6])
         self.rep_fs.append(face_sharp[fperm[f]])
@@ -321,40 +323,25 @@ class PatchTable:
         ``row``, ``col``, ``val``, once per distinct content: patches that differ in shape
         alone (most keys beside creases, and every input face's in a regular region) share
         their step's rows, so the table holds each once (a fifth of the entries on fandisk's
-        hybrid) and the carry reads fewer distinct ones."""
-        h = _segment_hashes(row, col, val, bounds)
+        hybrid) and the carry reads fewer distinct ones. Contents are told apart by their
+        bytes (the weights by their bits), so sharing is exact."""
         n = np.diff(bounds)
-        start = np.full(len(cands), -1, np.int64)  # where each one's entries are stored
-        copy = np.full(len(cands), -1, np.int64)  # or the one of this batch it repeats
-        first: dict[tuple, int] = {}
-        keys = list(zip(h[:, 0].tolist(), h[:, 1].tolist(), n.tolist()))
-        for i, key in enumerate(keys):
-            known = self._t_index.get(key)
-            if known is not None:
-                start[i] = known
-            elif key in first:
-                copy[i] = first[key]
-            else:
-                first[key] = i
-        # A hash is not taken on trust: what is reused must be equal entry for entry.
-        old = np.flatnonzero(start >= 0)
-        stored = (self.t_row.a, self.t_col.a, self.t_val.a)
-        same = _same_segments((row, col, val), bounds[old], stored, start[old], n[old])
-        start[old[~same]] = -1
-        dup = np.flatnonzero(copy >= 0)
-        same = _same_segments((row, col, val), bounds[dup], (row, col, val), bounds[copy[dup]], n[dup])
-        copy[dup[~same]] = -1
-        own = np.flatnonzero((start < 0) & (copy < 0))
+        start = np.empty(len(cands), np.int64)
+        own = []
+        end = self.t_row.n  # where the next new one goes
+        for i, (a, b) in enumerate(zip(bounds[:-1].tolist(), bounds[1:].tolist())):
+            key = row[a:b].tobytes() + col[a:b].tobytes() + val[a:b].tobytes()
+            at = self._t_index.get(key)
+            if at is None:
+                at = self._t_index[key] = end
+                self._t_key_bytes += len(key)
+                own.append(i)
+                end += b - a
+            start[i] = at
         keep = _ranges(bounds[own], n[own])
-        base = self.t_row.append(row[keep])
+        self.t_row.append(row[keep])
         self.t_col.append(col[keep])
         self.t_val.append(val[keep])
-        start[own] = base + np.concatenate([[0], np.cumsum(n[own])[:-1]])
-        for i in first.values():
-            if start[i] >= 0:
-                self._t_index[keys[i]] = int(start[i])
-        dup = np.flatnonzero(copy >= 0)
-        start[dup] = start[copy[dup]]
         self.t_start.a[cands] = start
         self.t_end.a[cands] = start + n
 
@@ -404,46 +391,16 @@ class PatchTable:
         return ids
 
 
+def _firsts(lengths: np.ndarray) -> np.ndarray:
+    """Where each of consecutive runs of ``lengths`` starts: their exclusive prefix sums."""
+    out = np.zeros(len(lengths), np.int64)
+    np.cumsum(lengths[:-1], out=out[1:])
+    return out
+
+
 def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """``concatenate([arange(s, s + n) for s, n in zip(starts, lengths)])``."""
-    offs = np.concatenate([[0], np.cumsum(lengths)[:-1]])
-    return np.repeat(starts - offs, lengths) + np.arange(int(lengths.sum()))
-
-
-def _same_segments(mine, at, theirs, their_at, lengths) -> np.ndarray:
-    """Whether each segment of the arrays ``mine`` from ``at`` equals that of ``theirs`` from
-    ``their_at`` (``lengths`` entries each), bit for bit."""
-    if not len(lengths):
-        return np.ones(0, bool)
-    a, b = _ranges(at, lengths), _ranges(their_at, lengths)
-    eq = np.ones(len(a), bool)
-    for x, y in zip(mine, theirs):
-        bits = np.int64 if x.itemsize == 8 else np.int32  # floats by their bits: -0.0 is not 0.0
-        eq &= x[a].view(bits) == y[b].view(bits)
-    live = lengths > 0
-    out = np.ones(len(lengths), bool)
-    out[live] = np.logical_and.reduceat(eq, np.concatenate([[0], np.cumsum(lengths)[:-1]])[live])
-    return out
-
-
-def _segment_hashes(row, col, val, bounds) -> np.ndarray:
-    """Two 64-bit hashes (k, 2) of each segment ``bounds[i]:bounds[i + 1]`` of the entries:
-    every entry mixed with its place in its segment (splitmix64's finaliser), summed."""
-    n = np.diff(bounds)
-    place = (np.arange(len(row)) - np.repeat(bounds[:-1], n)).astype(np.uint64)
-    out = np.zeros((len(n), 2), np.uint64)
-    with np.errstate(over="ignore"):
-        for j, salt in enumerate((np.uint64(0x9E3779B97F4A7C15), np.uint64(0xD1B54A32D192ED03))):
-            x = (row.astype(np.uint64) << np.uint64(32)) ^ col.astype(np.uint64)
-            x = x * salt ^ val.view(np.uint64) ^ (place + np.uint64(1)) * np.uint64(0xBF58476D1CE4E5B9)
-            x ^= x >> np.uint64(30)
-            x *= np.uint64(0xBF58476D1CE4E5B9)
-            x ^= x >> np.uint64(27)
-            x *= np.uint64(0x94D049BB133111EB) + salt
-            x ^= x >> np.uint64(31)
-            live = n > 0
-            out[live, j] = np.add.reduceat(x, bounds[:-1][live]) if len(x) else 0
-    return out
+    return np.repeat(starts - _firsts(lengths), lengths) + np.arange(int(lengths.sum()))
 
 
 def _sorted(a: np.ndarray) -> bool:
