@@ -58,7 +58,8 @@ def child_corners(F, twin, shape, faces1, parent, sup_ids, sup_w, out):
             slot[p] = used
             for c in range(3):
                 gids[used, 0, c] = F[p, c]
-                gpos[used, 0, c] = shape[p, c]
+                gpos[used, 0, c, 0] = shape[p, c, 0]
+                gpos[used, 0, c, 1] = shape[p, c, 1]
                 tw = twin[3 * p + c]
                 for a in range(3):
                     gids[used, c + 1, a] = F[tw // 3, a] if tw >= 0 else -2  # −2 matches nothing

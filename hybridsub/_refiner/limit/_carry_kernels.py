@@ -187,7 +187,7 @@ def _back_three(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, b
     return s
 
 
-@kernel(inline="always")
+@kernel
 def _back_point(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
                 t_end, t_row, t_col, t_val):
     """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``. One
@@ -295,7 +295,7 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
 back_points, back_points_serial = threaded_and_serial(_back_points)
 
 
-@kernel(inline="always")
+@kernel
 def _forward_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
                  t_end, t_row, t_col, t_val, base, vids, X, S, res, first):
     """Rows ``first:`` of point ``q`` (derivatives: their weights sum to zero) applied to the

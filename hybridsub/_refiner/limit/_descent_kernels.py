@@ -107,7 +107,7 @@ def cut_pieces(F, twin, n, node, f):
                     vmark[v] = i
                     vsel[nv] = v
                     nv += 1
-        vsel[start:nv] = np.sort(vsel[start:nv])
+        vsel[start:nv].sort()
         for j in range(start, nv):
             vnew[vsel[j]] = j
         for r in range(a, b):
