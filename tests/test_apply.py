@@ -140,3 +140,15 @@ def test_one_thread_and_all_give_the_same_bits(monkeypatch, tmp_path):
     import numba
     assert numba.get_num_threads() == 1
     hybridsub.set_threads(None)
+
+
+def test_steps_read_each_level_in_order():
+    """The coded steps renumber every level between two steps in the order the next step
+    first reads it (its gathers then walk that level almost in sequence), same bits."""
+    V, V2, r = _refinement("loop", levels=3)
+    r.apply(V)
+    assert np.array_equal(r.apply(V), V2)  # coded, in read order
+    for C in r._stencils()[1:]:
+        first = np.full(C.shape[1], len(C.indices))
+        np.minimum.at(first, C.indices.astype(np.int64), np.arange(len(C.indices)))
+        assert np.all(np.diff(first) >= 0)

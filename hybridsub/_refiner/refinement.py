@@ -21,7 +21,7 @@ from .chart import vertex_origins
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
 from .multires import MultiresDetails, decompose, reconstruct
-from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, step_matrix
+from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order, step_matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -234,7 +234,7 @@ class Refinement:
             if not self._cache.pop("uncoded " + key, False):
                 self._cache["uncoded " + key] = True
                 return mats
-            self._cache[key] = [coded_stencils(S) or S for S in mats]
+            self._cache[key] = [coded_stencils(S) or S for S in in_read_order(mats)]
         return self._cache[key]
 
     def decompose(self, X: ArrayLike, *, frames: bool | None = None) -> tuple[np.ndarray, MultiresDetails]:

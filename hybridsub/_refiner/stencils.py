@@ -60,6 +60,54 @@ def apply_matrix(S: sp.csr_matrix, X: np.ndarray, out: np.ndarray | None = None)
     return out
 
 
+def in_read_order(steps: list[sp.csr_matrix]) -> list[sp.csr_matrix]:
+    """The chain ``S_L ⋯ S_1`` with each level between two steps renumbered in the order the
+    next step first reads its vertices: ``P_k S_k P_(k−1)ᵀ`` with ``P_0``, ``P_L`` the identity.
+
+    Rows keep their entries in order, so multiplying the chain gives the same bits. A step
+    numbers its new vertices edge by edge, so the next step's rows read a level of 10⁵–10⁶
+    vertices all over; in read order they walk it almost in sequence (armadillo, three Loop
+    steps, one frame: 70–75 → 54–59 ms on one thread).
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V, F = hybridsub.load_example()
+    >>> r = hybridsub.refine(F, levels=2)
+    >>> S2, S1 = (s.matrix for s in reversed(r.steps))
+    >>> T1, T2 = in_read_order([S1, S2])
+    >>> np.array_equal(T2 @ (T1 @ V), S2 @ (S1 @ V))
+    True
+    """
+    out = [sp.csr_matrix(S, copy=False) for S in steps]
+    for k in range(len(out) - 1, 0, -1):
+        nxt = out[k]
+        first = np.full(nxt.shape[1], nxt.nnz, np.int64)
+        np.minimum.at(first, nxt.indices, np.arange(nxt.nnz))
+        order = np.argsort(first, kind="stable")  # new number → old
+        renumber = np.empty_like(order)
+        renumber[order] = np.arange(len(order))
+        out[k] = _same_entries(nxt, renumber[nxt.indices].astype(nxt.indices.dtype))
+        prev = out[k - 1]
+        sizes = np.diff(prev.indptr)[order]
+        indptr = np.zeros(len(order) + 1, prev.indptr.dtype)
+        np.cumsum(sizes, out=indptr[1:])
+        take = np.repeat(prev.indptr[:-1][order] - indptr[:-1], sizes) + np.arange(indptr[-1])
+        out[k - 1] = _same_entries(prev, prev.indices[take], prev.data[take], indptr)
+    return out
+
+
+def _same_entries(S: sp.csr_matrix, indices: np.ndarray, data: np.ndarray | None = None,
+                  indptr: np.ndarray | None = None) -> sp.csr_matrix:
+    """A CSR matrix of ``S``'s shape from these arrays as they are (SciPy neither sorts nor
+    narrows them)."""
+    M = sp.csr_matrix(S.shape, dtype=np.float64)
+    M.data = S.data if data is None else data
+    M.indices = indices
+    M.indptr = S.indptr if indptr is None else indptr
+    return M
+
+
 #: Most distinct weights a coded matrix holds (its codes are uint16).
 MAX_CODES = 1 << 16
 
