@@ -189,8 +189,9 @@ class Refinement:
         has been formed, ``apply`` multiplies by it (one pass over the data, the product
         ``matrix @ X`` to the bit); before, by the step matrices one after the other
         (``subdivide``'s result to the bit). From the second call on, either is held with its
-        distinct weights stored once (a 2-byte code an entry, see ``docs/performance.md``), the
-        same bits faster; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
+        distinct weights stored once (a 2-byte code an entry, see ``docs/performance.md``), and
+        the steps with each level between two numbered as the next reads it: the same bits
+        faster; frames batched as ``(n, f, 3)`` or ``(n, 3 f)`` share one pass over it.
 
         Examples
         --------

@@ -150,9 +150,11 @@ def apply_coded(C: CodedStencils, X: np.ndarray, out: np.ndarray | None = None) 
     X = np.ascontiguousarray(X, dtype=np.float64)
     out = np.empty((C.shape[0], X.shape[1]), np.float64) if out is None else out
     threaded = use_threads(C.shape[0])
-    if X.shape[1] == 3:
+    if X.shape[1] == 3:  # a frame of positions: one row's three sums in one vector register
+        x4 = np.zeros((X.shape[0], 4))
+        x4[:, :3] = X
         kernel = K.coded_apply3 if threaded else K.coded_apply3_serial
-        kernel(C.indptr, C.indices, C.codes, C.weights, X.reshape(-1), out.reshape(-1))
+        kernel(C.indptr, C.indices, C.codes, C.weights, x4.reshape(-1), out.reshape(-1))
     else:
         kernel = K.coded_apply if threaded else K.coded_apply_serial
         kernel(C.indptr, C.indices, C.codes, C.weights, X, out)
