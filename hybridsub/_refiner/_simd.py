@@ -24,8 +24,9 @@ Examples
 
 from __future__ import annotations
 
+import numpy as np
 from llvmlite import ir
-from numba.core import types
+from numba.core import config, types
 from numba.extending import intrinsic, models, register_model
 
 _V4 = ir.VectorType(ir.DoubleType(), 4)
@@ -83,3 +84,14 @@ def lane(typingctx, acc, i):
     def codegen(context, builder, signature, args):
         return builder.extract_element(args[0], args[1])
     return types.float64(vec4, i), codegen
+
+
+if config.DISABLE_JIT:  # the kernels run as Python: the same operations on a NumPy array
+    def vzero():  # noqa: F811
+        return np.zeros(4)
+
+    def madd4(acc, w, x, at):  # noqa: F811
+        return acc + w * x[at:at + 4]
+
+    def lane(acc, i):  # noqa: F811
+        return float(acc[i])
