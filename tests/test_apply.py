@@ -152,3 +152,35 @@ def test_steps_read_each_level_in_order():
         first = np.full(C.shape[1], len(C.indices))
         np.minimum.at(first, C.indices.astype(np.int64), np.arange(len(C.indices)))
         assert np.all(np.diff(first) >= 0)
+
+
+def _scipy_product(A, B):
+    D = sp.csr_matrix(A @ B)
+    D.sort_indices()
+    return D
+
+
+def _same_csr(C, D):
+    return (C.shape == D.shape and np.array_equal(C.indptr, D.indptr) and np.array_equal(C.indices, D.indices)
+            and np.array_equal(C.data.view(np.int64), D.data.view(np.int64)))
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+@pytest.mark.parametrize("name", ["hybrid", "loop-semisharp", "sqrt3"])
+def test_composite_is_scipys_product_to_the_bit(monkeypatch, name, threaded):
+    monkeypatch.setattr(_topo_kernels, "PARALLEL_MIN", 0 if threaded else 10**12)
+    _, _, r = _refinement(name, levels=3)
+    S = sp.identity(r.n_coarse, format="csr")
+    for st in r.steps:
+        C = _stencils.product(st.matrix, S)
+        S = _scipy_product(st.matrix, S)
+        assert _same_csr(C, S) and C.has_sorted_indices
+    assert _same_csr(r.matrix, S)
+
+
+def test_product_drops_the_sums_that_cancel_as_scipy():
+    A = sp.csr_matrix(np.array([[1.0, -1.0, 0.0], [0.5, 0.0, 2.0], [0.0, 0.0, 0.0], [-0.0, 1.0, 0.0]]))
+    B = sp.csr_matrix(np.array([[1.0, 3.0, 0.0, 1e-300], [1.0, 2.0, 0.0, 1e-300], [0.0, 0.0, 4.0, -0.0]]))
+    C = _stencils.product(A, B)
+    assert _same_csr(C, _scipy_product(A, B))
+    assert C[0].nnz == 1  # column 0 and the tiny column cancel exactly: dropped, as SciPy drops them

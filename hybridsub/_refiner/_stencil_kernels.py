@@ -21,6 +21,7 @@ from ._simd import lane, madd4, vzero
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
 _THIRD = 1.0 / 3.0
+_U1, _U2, _U3, _U4 = np.uintp(1), np.uintp(2), np.uintp(3), np.uintp(4)  # unsigned offsets: no negative-index test
 
 
 @kernel(inline="always")
@@ -230,13 +231,75 @@ def product_bound(a_indptr, a_indices, b_indptr, n_cols):
     return total
 
 
+@kernel(parallel=True)
+def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, counts):
+    """``counts[i]``: the distinct columns of row i of ``A @ B`` (CSR patterns), ``chunks``
+    ranges of rows in parallel."""
+    m = len(a_indptr) - 1
+    for c in prange(chunks):
+        mark = np.full(n_cols, -1, np.int32)
+        for i in range(c * m // chunks, (c + 1) * m // chunks):
+            n = 0
+            i32 = np.int32(i)
+            for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
+                j = np.uintp(a_indices[q])
+                for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
+                    k = np.uintp(b_indices[p])
+                    if mark[k] != i32:
+                        mark[k] = i32
+                        n += 1
+            counts[i] = n
+
+
+@kernel(parallel=True)
+def product_fill(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_cols, chunks, c_indptr, c_indices,
+                 c_data, kept):
+    """Row i of ``A @ B`` into ``c_indices``, ``c_data`` from ``c_indptr[i]``, columns sorted,
+    the sums that are exactly zero dropped (``kept[i]`` entries left), as SciPy's product
+    followed by ``sort_indices``: each sum starts at zero and adds ``A[i, j] * B[j, k]`` in
+    the order of A's row, then of B's rows, so it has SciPy's bits."""
+    m = len(a_indptr) - 1
+    for c in prange(chunks):
+        sums = np.zeros(n_cols)
+        mark = np.full(n_cols, -1, np.int32)
+        for i in range(c * m // chunks, (c + 1) * m // chunks):
+            o = np.uintp(c_indptr[i])
+            n = np.uintp(0)
+            i32 = np.int32(i)
+            for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
+                j = np.uintp(a_indices[q])
+                v = a_data[q]
+                for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
+                    k = np.uintp(b_indices[p])
+                    sums[k] += v * b_data[p]
+                    if mark[k] != i32:
+                        mark[k] = i32
+                        c_indices[o + n] = k
+                        n += _U1
+            for t in range(o + _U1, o + n):  # insertion sort: rows are short
+                k = c_indices[t]
+                u = t
+                while u > o and c_indices[u - _U1] > k:
+                    c_indices[u] = c_indices[u - _U1]
+                    u -= _U1
+                c_indices[u] = k
+            w = np.uintp(0)
+            for t in range(o, o + n):
+                k = np.uintp(c_indices[t])
+                if sums[k] != 0.0:
+                    c_indices[o + w] = k
+                    c_data[o + w] = sums[k]
+                    w += _U1
+                sums[k] = 0.0
+            kept[i] = w
+
+
 # ---------------------------------------------------------------------------------------
 # Coded stencils: a CSR matrix whose few distinct weights are stored once, each entry
 # holding a uint16 code into that table and a uint16 column where the columns allow (4 bytes
 # an entry instead of 12 with int32 indices). The products sum each row in stored order, as
 # ``_csr_apply``: the same bits.
 
-_U1, _U2, _U3, _U4 = np.uintp(1), np.uintp(2), np.uintp(3), np.uintp(4)  # unsigned offsets: no negative-index test
 _EMPTY_KEY = -1  # a slot of the hash table holding no weight (no float64 has these bits: a NaN)
 
 

@@ -21,7 +21,7 @@ from .chart import vertex_origins
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
 from .multires import MultiresDetails, decompose, reconstruct
-from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order, step_matrix
+from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order, product, step_matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,9 +143,7 @@ class Refinement:
             S = sp.identity(self.n_coarse, format="csr", dtype=np.float64)
             for st in self.steps:
                 check_product(st.matrix, S, self.max_memory)  # size guard
-                S = st.matrix @ S
-            S = sp.csr_matrix(S)
-            S.sort_indices()
+                S = product(st.matrix, S)
             self._cache["matrix"] = S
         return self._cache["matrix"]
 
