@@ -373,7 +373,7 @@ def check_product(A, B, max_memory=None, what="the composite refinement matrix")
         return
     nnz = float(product_bound(A.indptr, A.indices, B.indptr, B.shape[1]))
     idx = 8 if max(nnz, B.shape[1], A.shape[0]) >= _stencils.INT32_LIMIT else 4
-    # the product, and scipy's temporaries (about as large again)
+    # the product, and its pattern pass and copies (bounded by as much again)
     need = 2 * (nnz * (8 + idx) + (A.shape[0] + 1) * idx)
     if need > limit:
         s = _suggest(need)
