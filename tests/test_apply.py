@@ -1,11 +1,13 @@
 """Refinement.apply on coded stencils (issue 18): the bits of subdivide before the composite
 matrix is formed, the bits of ``matrix @ X`` after, on every kernel path."""
 
+import numba
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import hybridsub
+from hybridsub._refiner import _simd
 from hybridsub._refiner import stencils as _stencils
 from hybridsub._topology import _kernels as _topo_kernels
 
@@ -184,3 +186,19 @@ def test_product_drops_the_sums_that_cancel_as_scipy():
     C = _stencils.product(A, B)
     assert _same_csr(C, _scipy_product(A, B))
     assert C[0].nnz == 1  # column 0 and the tiny column cancel exactly: dropped, as SciPy drops them
+
+
+@numba.njit
+def _lanes_after(first, w, x4):
+    acc = _simd.madd4(_simd.vzero(), 1.0, first, np.uintp(0))
+    acc = _simd.madd4(acc, w, x4, np.uintp(0))
+    return _simd.lane(acc, 0), _simd.lane(acc, 1), _simd.lane(acc, 2), _simd.lane(acc, 3)
+
+
+def test_vector_lanes_multiply_then_add_as_the_scalar_code():
+    """A fused multiply-add would keep the product's low bits: (1 + 2⁻³⁰)² − its rounding is
+    2⁻⁶⁰, not the 0 the scalar code gives."""
+    w = x = 1.0 + 2.0**-30
+    p = w * x
+    assert _lanes_after(np.full(4, -p), w, np.full(4, x)) == (0.0, 0.0, 0.0, 0.0)
+    assert _lanes_after(np.arange(4.0), 0.5, np.arange(4.0, 8.0)) == (2.0, 3.5, 5.0, 6.5)
