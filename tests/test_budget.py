@@ -237,6 +237,7 @@ def test_product_bound_is_an_upper_bound():
 # ----------------------------------------------------------------- int32 / int64 indices
 
 
+@pytest.mark.slow  # compiles every kernel of the refinement again for int64 indices (~10 s)
 @pytest.mark.parametrize("scheme", SCHEMES)
 def test_int64_index_path(monkeypatch, scheme):
     V, F = ms.torus(6, 5)

@@ -77,17 +77,22 @@ def product(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
     """
     m, n_cols = A.shape[0], B.shape[1]
     chunks = 4 * numba.get_num_threads() if use_threads(m) else 1
+    # the inputs' indices all int32, or all int64 if one is (the kernels compile for two
+    # signatures, not one per mix); the product's int64 if an input's are, as SciPy chooses
+    wide = any(a.dtype != np.int32 for a in (A.indptr, A.indices, B.indptr, B.indices))
+    a_ptr, a_idx, b_ptr, b_idx = (a.astype(np.int64 if wide else np.int32, copy=False)
+                                  for a in (A.indptr, A.indices, B.indptr, B.indices))
     counts = np.empty(m, np.int64)
-    K.product_pattern(A.indptr, A.indices, B.indptr, B.indices, n_cols, chunks, counts)
+    K.product_pattern(a_ptr, a_idx, b_ptr, b_idx, n_cols, chunks, counts)
     indptr = np.zeros(m + 1, np.int64)
     np.cumsum(counts, out=indptr[1:])
     nnz = int(indptr[-1])
-    index = np.int32 if max(m, n_cols, nnz) < INT32_LIMIT else np.int64
+    index = np.int64 if wide or max(m, n_cols, nnz) >= INT32_LIMIT else np.int32
     indices = np.empty(nnz, index)
     data = np.empty(nnz, np.float64)
     kept = np.empty(m, np.int64)
-    K.product_fill(A.indptr, A.indices, np.asarray(A.data, np.float64), B.indptr, B.indices,
-                   np.asarray(B.data, np.float64), n_cols, chunks, indptr, indices, data, kept)
+    K.product_fill(a_ptr, a_idx, np.asarray(A.data, np.float64), b_ptr, b_idx, np.asarray(B.data, np.float64), n_cols,
+                   chunks, indptr, indices, data, kept)
     if int(kept.sum()) < nnz:  # exact zero sums were dropped: close the gaps
         keep = np.arange(nnz) - np.repeat(indptr[:-1], counts) < np.repeat(kept, counts)
         indices, data = indices[keep], data[keep]
