@@ -24,6 +24,7 @@ _T0, _T1, _T2 = KOBBELT_TRISECTION
 _THIRD = 1.0 / 3.0
 _U1, _U2, _U3, _U4 = np.uintp(1), np.uintp(2), np.uintp(3), np.uintp(4)  # unsigned offsets: no negative-index test
 _PREFETCH_FROM = 2**17  # values of X (1 MB, a core's L2 cache): below, prefetching only costs
+_ROW_AHEAD = 16  # entries of A between prefetching a row of B and reading it
 _AHEAD = 32  # halfedges between a prefetch and its use (armadillo's last Loop step: 16 → 26, 32 and 64 → 23 ms)
 
 
@@ -238,6 +239,21 @@ def _csr_apply(indptr, indices, data, X, out):
 csr_apply, csr_apply_serial = threaded_and_serial(_csr_apply)
 
 
+@kernel(inline="always")
+def _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_data):
+    """Prefetch the row of B that entry ``q + _ROW_AHEAD`` of A reads (its columns and
+    weights), and where the row of entry ``q + 2 _ROW_AHEAD`` starts: A's columns pick B's
+    rows all over B, each found through ``b_indptr`` (two loads that miss, one on the other)."""
+    far = q + np.uintp(2 * _ROW_AHEAD)
+    if far < a_indices.shape[0]:
+        prefetch(b_indptr, a_indices[far])
+    near = q + np.uintp(_ROW_AHEAD)
+    if near < a_indices.shape[0]:
+        start = b_indptr[a_indices[near]]
+        prefetch(b_indices, start)
+        prefetch(b_data, start)
+
+
 @kernel
 def product_bound(a_indptr, a_indices, b_indptr, n_cols):
     """Entries ``A @ B`` can have at most (CSR patterns): row i of the product has at most
@@ -263,6 +279,7 @@ def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, co
             n = 0
             i32 = np.int32(i)
             for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
+                _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_indices)
                 j = np.uintp(a_indices[q])
                 for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
                     k = np.uintp(b_indices[p])
@@ -288,6 +305,7 @@ def product_fill(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_col
             n = np.uintp(0)
             i32 = np.int32(i)
             for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
+                _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_data)
                 j = np.uintp(a_indices[q])
                 v = a_data[q]
                 for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
