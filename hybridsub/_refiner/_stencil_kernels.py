@@ -44,6 +44,17 @@ def _prefetch_across(h, F, twin, edge_point, X):
 
 
 @kernel(inline="always")
+def _has_edge_points(face_point, n, n_new):
+    """Whether a step of ``n`` old vertices and ``n_new`` in all makes edge points: they are
+    numbered before the face points, so the first face point says how many there are (√3's
+    steps have none but on a boundary, and their edge loop is then skipped)."""
+    for f in range(face_point.shape[0]):
+        if face_point[f] >= 0:
+            return face_point[f] > n
+    return n_new > n
+
+
+@kernel(inline="always")
 def _neighbour_coefficient(v, s, coef):
     c = coef[1, v]
     if s > 0.0:
@@ -86,7 +97,7 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
                     for j in range(k):
                         out[w, j] += cw * X[u, j]
     fetch = X.size > _PREFETCH_FROM
-    for h in prange(3 * m):
+    for h in prange(3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0):
         if fetch:
             _prefetch_across(h, F, twin, edge_point, X)
         r = edge_point[h]

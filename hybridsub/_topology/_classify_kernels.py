@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel
+from .._jit import kernel, threaded_and_serial
 from .._rules.refinement import (
     CORNER,
     EDGE_FLIP,
@@ -205,15 +205,14 @@ def _count_range(lo, hi, F, twin, hsharp, has_tags, face_sharp, mixed, counts, s
                     counts[5, v] += sh
 
 
-@kernel
-def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
-                        coefficients):
+def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
+                         coefficients):
     """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
     parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
     non-smooth vertex (Kobbelt's odd steps). ``region_of_all`` is every vertex's region when
     the faces are all sharp or all smooth, −1 when the counts must decide."""
     n = counts.shape[1]
-    for v in range(n):
+    for v in prange(n):
         rp = vertex_rule(counts[1, v], corner[v])
         rc = vertex_rule(counts[2, v], corner[v])
         if fix_boundary and rp != SMOOTH:
@@ -234,3 +233,6 @@ def vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs,
         coefficients[1, v] = b
         coefficients[2, v] = p
         coefficients[3, v] = c
+
+
+vertex_coefficients, vertex_coefficients_serial = threaded_and_serial(_vertex_coefficients)

@@ -45,7 +45,7 @@ class StepPlan:
     trisected: np.ndarray  # (m,) int8 local index of the trisected boundary halfedge, −1 if none
     coefficients: np.ndarray  # (4, n): every vertex mask, see _rules.vertex_mask
     n_new: int
-    bnext: np.ndarray  # (3m,) boundary links, only filled for Kobbelt's even steps
+    bnext: np.ndarray  # (3m,) boundary links, only for Kobbelt's even steps with edges to trisect (else empty)
     bprev: np.ndarray
 
 
@@ -85,8 +85,9 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
-    C.vertex_coefficients(counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
-    if sqrt3 and not odd:
+    (C.vertex_coefficients if K.use_threads(m) else C.vertex_coefficients_serial)(
+        counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
+    if sqrt3 and not odd and trisected.max(initial=-1) >= 0:  # boundary edges to trisect
         bnext, bprev = K.boundary_links(F, twin)
     else:
         bnext = bprev = EMPTY_INT
