@@ -145,19 +145,20 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
         hi = (c + 1) * n // chunks
         for v in range(lo, hi):
             _sum1(out, v, coef[0, v], v, X)
-        for h in range(3 * m):
-            u, w, mine_u, mine_w = owned_ends_in(F, twin, h, lo, hi)
-            if not (mine_u or mine_w):
-                continue
-            s = edge_sharpness(h, twin, hsharp, has_tags)
-            if mine_u:
-                cu = coef[1, u] if s == 0.0 else _neighbour_coefficient(u, s, coef)
-                if cu != 0.0:
-                    _add1(out, u, cu, w, X)
-            if mine_w:
-                cw = coef[1, w] if s == 0.0 else _neighbour_coefficient(w, s, coef)
-                if cw != 0.0:
-                    _add1(out, w, cw, u, X)
+        for f in range(m):
+            for i in range(3):
+                u, w, mine_u, mine_w = owned_ends_in(F, twin, f, i, lo, hi)
+                if not (mine_u or mine_w):
+                    continue
+                s = edge_sharpness(3 * f + i, twin, hsharp, has_tags)
+                if mine_u:
+                    cu = coef[1, u] if s == 0.0 else _neighbour_coefficient(u, s, coef)
+                    if cu != 0.0:
+                        _add1(out, u, cu, w, X)
+                if mine_w:
+                    cw = coef[1, w] if s == 0.0 else _neighbour_coefficient(w, s, coef)
+                    if cw != 0.0:
+                        _add1(out, w, cw, u, X)
     fetch = X.size > _PREFETCH_FROM
     for h in prange(3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0):
         if fetch:

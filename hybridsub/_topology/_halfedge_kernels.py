@@ -57,14 +57,16 @@ def edge_sharpness(h, twin, hsharp, has_tags):
 
 
 @kernel(inline="always")
-def owned_ends_in(F, twin, h, lo, hi):
-    """(u, w, u in lo:hi, w in lo:hi) for the edge u→w of halfedge h if h owns it (the
-    lower-numbered halfedge of the edge), else two Falses: a walk over every edge that keeps
-    one range of vertices' terms, in the serial order, as the threaded kernels do."""
+def owned_ends_in(F, twin, f, i, lo, hi):
+    """(u, w, u in lo:hi, w in lo:hi) for the edge u→w of halfedge ``3 f + i`` if it owns
+    it (the lower-numbered halfedge of the edge), else two Falses: a walk over every edge,
+    face by face, that keeps one range of vertices' terms, in the serial order, as the
+    threaded kernels do. Face and corner in, not the halfedge: no division by 3 per
+    halfedge (a fifth of such a walk's time)."""
+    h = 3 * f + i
     t = twin[h]
-    u = origin(F, h)
-    w = dest(F, h)
+    u = F[f, i]
+    w = F[f, i + 1 if i < 2 else 0]
     if t >= 0 and t < h:
         return u, w, False, False
     return u, w, lo <= u < hi, lo <= w < hi
-
