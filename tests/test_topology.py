@@ -136,3 +136,18 @@ def test_classification_in_chunks_equals_the_serial_pass(data, scheme, odd, chun
     assert n_chunks == n_serial
     for a, b in zip(serial, chunked):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_far_twins_tells_scattered_faces_from_ordered_ones():
+    """Prefetching across edges is switched on by far_twins: a grid written row by row has
+    its faces across edges close by, the same grid with its faces shuffled far away."""
+    from hybridsub._topology import build_level, far_twins
+    k = 200  # 2 k² = 80 000 faces, above the 32k faces the probe looks at
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    v = (i * (k + 1) + j).ravel()
+    F = np.concatenate([np.stack([v, v + k + 1, v + 1], 1), np.stack([v + 1, v + k + 1, v + k + 2], 1)])
+    F = F.reshape(2, k * k, 3).transpose(1, 0, 2).reshape(-1, 3)  # the two triangles of a cell together
+    assert not far_twins(build_level(F, (k + 1) ** 2).twin)
+    shuffled = F[np.random.default_rng(0).permutation(len(F))]
+    assert far_twins(build_level(shuffled, (k + 1) ** 2).twin)
+    assert not far_twins(build_level(shuffled[:30000], (k + 1) ** 2).twin)  # too small to matter

@@ -17,7 +17,7 @@ from numba import prange
 from .._jit import kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
-from .._topology import dest, edge_sharpness, opposite, origin, owned_ends_in
+from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_ends_in
 from ._simd import lane, madd4, vzero
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
@@ -159,7 +159,7 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
                     cw = coef[1, w] if s == 0.0 else _neighbour_coefficient(w, s, coef)
                     if cw != 0.0:
                         _add1(out, w, cw, u, X)
-    fetch = X.size > _PREFETCH_FROM
+    fetch = X.size > _PREFETCH_FROM and far_twins(twin)
     for h in prange(3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0):
         if fetch:
             _prefetch_across(h, F, twin, edge_point, X)

@@ -27,7 +27,7 @@ from .._rules.refinement import (
     EDGE_SPLIT,
     EDGE_TRISECT,
 )
-from ._halfedge_kernels import dest, next_in_face, prev_in_face
+from ._halfedge_kernels import dest, far_twins, next_in_face, prev_in_face
 
 # Error codes of halfedge_twins.
 OK = 0
@@ -176,10 +176,9 @@ def boundary_links(F, twin):
     return bnext, bprev
 
 
-# Prefetching the faces across edges pays from some 32k faces on (below, what it reads is
-# cached anyway); armadillo's three levels, one thread, same process: Loop 61 -> 49 ms,
-# sqrt3 40 -> 28 ms (the last level's twins included).
-_PREFETCH_FACES = 2**15
+# Prefetching the faces across edges pays where they lie far apart (far_twins); armadillo's
+# three levels, one thread, same process: Loop 61 -> 49 ms, sqrt3 40 -> 28 ms (the last
+# level's twins included).
 _FACES_AHEAD = 16
 
 
@@ -347,7 +346,7 @@ def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sh
     ``has_tags``: children of creases with s > 1 carry s − 1) and sharp-face mask ``fs``
     (zeroed), derived from this level's (no search)."""
     m = face_sharp.shape[0]
-    fetch = m > _PREFETCH_FACES
+    fetch = far_twins(twin)
     for f in prange(m):
         if fetch and f + _FACES_AHEAD < m:
             _prefetch_across(3 * (f + _FACES_AHEAD), twin, hkind, face_point, face_sharp, first)
