@@ -160,33 +160,50 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
                     if cw != 0.0:
                         _add1(out, w, cw, u, X)
     fetch = X.size > _PREFETCH_FROM and far_twins(twin)
-    for h in prange(3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0):
-        if fetch:
-            _prefetch_across(h, F, twin, edge_point, X)
-        r = edge_point[h]
-        t = twin[h]
-        if r < 0 or (t >= 0 and t < h):
-            continue
-        u = origin(F, h)
-        w = dest(F, h)
-        if hkind[h] == EDGE_TRISECT:
-            p0 = origin(F, bprev[h])
-            p3 = dest(F, bnext[h])
-            _sum3(out, r, _T0, p0, _T1, u, _T2, w, X)
-            _sum3(out, r + 1, _T2, u, _T1, w, _T0, p3, X)
-            continue
-        wab, wcd = edge_weights(edge_sharpness(h, twin, hsharp, has_tags))
-        if wcd == 0.0:
-            _sum2(out, r, wab, u, wab, w, X)
-        else:
-            _sum4(out, r, wab, u, wab, w, wcd, opposite(F, h), wcd, opposite(F, t), X)
-    for f in prange(m):
-        r = face_point[f]
-        if r >= 0:
-            a = F[f, 0]
-            b = F[f, 1]
-            c3 = F[f, 2]
-            _sum3(out, r, _THIRD, a, _THIRD, b, _THIRD, c3, X)
+    n_half = 3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0  # (prange(a if c else b) runs serially)
+    # On one thread plain loops: the threaded loops' machinery costs them a fifth there.
+    if chunks == 1:
+        for h in range(n_half):
+            _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch)
+        for f in range(m):
+            _face_point_row(f, X, F, face_point, out)
+    else:
+        for h in prange(n_half):
+            _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch)
+        for f in prange(m):
+            _face_point_row(f, X, F, face_point, out)
+
+
+@kernel(inline="always")
+def _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch):
+    """The row of the edge point(s) of halfedge ``h``'s edge, if ``h`` owns one."""
+    if fetch:
+        _prefetch_across(h, F, twin, edge_point, X)
+    r = edge_point[h]
+    t = twin[h]
+    if r < 0 or (t >= 0 and t < h):
+        return
+    u = origin(F, h)
+    w = dest(F, h)
+    if hkind[h] == EDGE_TRISECT:
+        p0 = origin(F, bprev[h])
+        p3 = dest(F, bnext[h])
+        _sum3(out, r, _T0, p0, _T1, u, _T2, w, X)
+        _sum3(out, r + 1, _T2, u, _T1, w, _T0, p3, X)
+        return
+    wab, wcd = edge_weights(edge_sharpness(h, twin, hsharp, has_tags))
+    if wcd == 0.0:
+        _sum2(out, r, wab, u, wab, w, X)
+    else:
+        _sum4(out, r, wab, u, wab, w, wcd, opposite(F, h), wcd, opposite(F, t), X)
+
+
+@kernel(inline="always")
+def _face_point_row(f, X, F, face_point, out):
+    """The row of face ``f``'s point, if it has one: the centroid."""
+    r = face_point[f]
+    if r >= 0:
+        _sum3(out, r, _THIRD, F[f, 0], _THIRD, F[f, 1], _THIRD, F[f, 2], X)
 
 
 apply_step, apply_step_serial = threaded_and_serial(_apply_step)
