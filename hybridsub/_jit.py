@@ -10,8 +10,8 @@ cache of unchanged sources loads as before.
 
 >>> import hybridsub
 >>> dependencies("hybridsub._topology._kernels")  # doctest: +NORMALIZE_WHITESPACE
-('hybridsub._jit', 'hybridsub._rules.refinement', 'hybridsub._topology._halfedge_kernels',
- 'hybridsub._topology._kernels')
+('hybridsub._jit', 'hybridsub._prefetch', 'hybridsub._rules.refinement',
+ 'hybridsub._topology._halfedge_kernels', 'hybridsub._topology._kernels')
 """
 
 from __future__ import annotations
@@ -23,12 +23,14 @@ import os
 import re
 import sys
 import types
+import warnings
 
 import numba
 import numpy as np
 from numba import njit
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
 from numba.core.dispatcher import Dispatcher
+from numba.core.errors import NumbaPerformanceWarning
 
 # ``from X import a, b`` (parenthesised over lines or not) and ``import X``, at a line's start.
 _FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
@@ -56,18 +58,45 @@ def kernel(fn=None, **options):
     if not isinstance(getattr(dispatcher, "_cache", None), NullCache):  # Numba's internals moved
         raise RuntimeError("numba's dispatcher keeps its cache elsewhere: update hybridsub._jit")
     dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # what Dispatcher.enable_caching does
+    if options.get("parallel") is NO_PARFORS:
+        dispatcher.compile = _quietly(dispatcher.compile)
     return dispatcher
+
+
+#: ``kernel(parallel=NO_PARFORS)``: Numba's parallel pipeline with every transformation off.
+#: ``prange`` runs as ``range`` and nothing runs on threads, but the code is the parallel
+#: pipeline's, which keeps arrays out of reference counting inside loops where Numba's plain
+#: pipeline counts references of array views on every iteration (armadillo's last Loop step
+#: on one thread: its classification in one pass 44 → 12 ms, its data 205 → 39 ms). The
+#: same operations, so the same bits. Used by the kernels of a step on one thread (the
+#: serial twins of :func:`threaded_and_serial`), whose outputs the tests check bit for bit;
+#: not everywhere: under it one limit-surface kernel (an in-place sort of a slice) computed
+#: something else.
+NO_PARFORS = {"prange": False, "numpy": False, "reduction": False, "setitem": False, "stencil": False,
+              "comprehension": False, "fusion": False, "inplace_binop": False}
+
+
+def _quietly(compile_):
+    """``compile_`` without Numba's warning that a parallel kernel found nothing to run on
+    threads (true, and meant: see :data:`NO_PARFORS`)."""
+    @functools.wraps(compile_)
+    def compile(sig):
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="(?s).*'parallel=True' was specified but no transformation",
+                                    category=NumbaPerformanceWarning)
+            return compile_(sig)
+    return compile
 
 
 def threaded_and_serial(fn):
     """Compile a kernel written with ``prange`` twice: threaded, and serial (``prange`` runs
-    as ``range``). The serial twin is a copy of the function under its own name, so the two
-    have separate on-disk caches. Returns ``(threaded, serial)``."""
+    as ``range``, :data:`NO_PARFORS`). The serial twin is a copy of the function under its
+    own name, so the two have separate on-disk caches. Returns ``(threaded, serial)``."""
     serial = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__,
                                 fn.__closure__)
     serial.__qualname__ = fn.__qualname__ + "_serial"
     serial.__doc__ = fn.__doc__
-    return kernel(parallel=True)(fn), kernel(serial)
+    return kernel(parallel=True)(fn), kernel(parallel=NO_PARFORS)(serial)
 
 
 def set_threads(n: int | None = None) -> int:

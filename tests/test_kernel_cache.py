@@ -159,3 +159,27 @@ def test_an_edited_rule_changes_the_package_as_an_empty_cache_does(tmp_path):
     edited_warm = _run(code, src, warm)
     edited_cold = _run(code, src, tmp_path / "empty")
     assert edited_warm == edited_cold != before
+
+
+def test_kernels_without_parfors_compile_quietly_and_run_serially():
+    """``kernel(parallel=NO_PARFORS)``: Numba's parallel pipeline with nothing on threads,
+    compiled without its warning that nothing runs on threads; ``prange`` runs in order."""
+    import warnings
+
+    import numpy as np
+
+    from hybridsub._jit import NO_PARFORS, kernel
+
+    def running_sum(x):
+        out = np.empty_like(x)
+        acc = 0.0
+        for i in numba.prange(len(x)):  # in order, or the running sum would be wrong
+            acc += x[i]
+            out[i] = acc
+        return out
+
+    quiet = kernel(parallel=NO_PARFORS)(running_sum)
+    quiet._cache = NullCache()  # a test function: nothing on disk
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert quiet(np.arange(5.0)).tolist() == [0.0, 1.0, 3.0, 6.0, 10.0]

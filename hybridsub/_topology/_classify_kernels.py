@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, threaded_and_serial
+from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._rules.refinement import (
     CORNER,
     EDGE_FLIP,
@@ -78,7 +78,7 @@ def _count_end(v, s, counts, s_frac):
             s_frac[v] += s
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, scheme, odd, hkind, edge_point,
                   face_point, trisected, counts, s_frac):
     """Edge kinds and the layout of the new points, plus the per-vertex numbers the rules need.

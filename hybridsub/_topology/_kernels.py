@@ -16,10 +16,11 @@ level's faces, then its twins and tags, derived from this level's instead of sea
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, threaded_and_serial
+from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.refinement import (
     EDGE_FLIP,
@@ -40,21 +41,21 @@ PARALLEL_MIN = 20000
 
 
 def use_threads(rows: int) -> bool:
-    """Whether a kernel over ``rows`` faces or rows runs its threaded twin (``PARALLEL_MIN``
-    read at call time). Also on one thread: Numba compiles the threaded twins to faster
-    code than the serial ones (armadillo's last Loop classification: 52 ms against 80 ms).
+    """Whether a kernel over ``rows`` faces or rows runs its threaded twin: from
+    ``PARALLEL_MIN`` rows (read at call time) and with more than one thread (on one, the
+    serial twins are faster: no threaded loops' machinery).
 
     >>> use_threads(10)
     False
     """
-    return rows >= PARALLEL_MIN
+    return rows >= PARALLEL_MIN and numba.get_num_threads() > 1
 
 
 # ---------------------------------------------------------------------------------------
 # Topology of an input mesh (level 0). Later levels get their twins from emit_topology.
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def group_by_origin(F, n_vertices):
     """Halfedges grouped by origin vertex (a counting sort): ``by_origin[start[v]:start[v+1]]``
     are the halfedges leaving v, in increasing order. Returns (by_origin, start)."""
@@ -75,7 +76,7 @@ def group_by_origin(F, n_vertices):
     return by_origin, start
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def halfedge_twins(F, n_vertices):
     """Twin of every halfedge (−1 on the boundary), and halfedges grouped by origin.
 
@@ -253,7 +254,7 @@ def _flip_start_twin(t, hkind, trisected, face_point, first):
     return -1
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def child_offsets(hkind, face_sharp, offsets, first):
     """Fill the first child face of every face (``offsets``, m + 1) and of every halfedge
     (``first``, 3m)."""
