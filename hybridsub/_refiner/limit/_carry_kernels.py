@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..._jit import kernel, threaded_and_serial
+from ..._jit import NO_PARFORS, kernel, threaded_and_serial
 from ._walk_kernels import TASK
 
 _U0, _U1 = np.uintp(0), np.uintp(1)
@@ -187,7 +187,7 @@ def _back_three(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, b
     return s
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def _back_point(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
                 t_end, t_row, t_col, t_val):
     """Point ``q``'s rows over its first patch's vertices into ``buf[s]``; returns ``s``. One
@@ -213,7 +213,7 @@ def _largest(stop, keys, nv):
     return nmax
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def back_rows(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start, t_end, t_row,
               t_col, t_val, out):
     """Every point's rows over its first patch's vertices: the weights ``W`` (q, r, 15) on its
@@ -295,7 +295,7 @@ def _back_points(W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, 
 back_points, back_points_serial = threaded_and_serial(_back_points)
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def _forward_one(q, buf, W, slots, block, stop, path, keys, nv, blk_v0, blk_c0, blk_nc, blk_col, blk_val, t_start,
                  t_end, t_row, t_col, t_val, base, vids, X, S, res, first):
     """Rows ``first:`` of point ``q`` (derivatives: their weights sum to zero) applied to the
