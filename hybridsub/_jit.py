@@ -68,10 +68,11 @@ def kernel(fn=None, **options):
 #: pipeline's, which keeps arrays out of reference counting inside loops where Numba's plain
 #: pipeline counts references of array views on every iteration (armadillo's last Loop step
 #: on one thread: its classification in one pass 44 → 12 ms, its data 205 → 39 ms). The
-#: same operations, so the same bits. Used by the kernels of a step on one thread (the
-#: serial twins of :func:`threaded_and_serial`), whose outputs the tests check bit for bit;
-#: not everywhere: under it one limit-surface kernel (an in-place sort of a slice) computed
-#: something else.
+#: same operations, so the same bits. Used by the serial twins of
+#: :func:`threaded_and_serial` (a step's kernels on one thread, the limit surface's walk),
+#: a step's one-pass kernels and the limit surface's per-point kernels, whose outputs the
+#: tests check bit for bit; not everywhere: with every kernel under it, one of the limit
+#: surface's patch-cutting kernels computed something else (not found which construct).
 NO_PARFORS = {"prange": False, "numpy": False, "reduction": False, "setitem": False, "stencil": False,
               "comprehension": False, "fusion": False, "inplace_binop": False}
 
