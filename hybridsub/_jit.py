@@ -29,6 +29,7 @@ import numba
 import numpy as np
 from numba import njit
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
+from numba.core.cpu_options import ParallelOptions
 from numba.core.dispatcher import Dispatcher
 from numba.core.errors import NumbaPerformanceWarning
 
@@ -73,8 +74,10 @@ def kernel(fn=None, **options):
 #: a step's one-pass kernels and the limit surface's per-point kernels, whose outputs the
 #: tests check bit for bit; not everywhere: with every kernel under it, one of the limit
 #: surface's patch-cutting kernels computed something else (not found which construct).
-NO_PARFORS = {"prange": False, "numpy": False, "reduction": False, "setitem": False, "stencil": False,
-              "comprehension": False, "fusion": False, "inplace_binop": False}
+#: (An options object, not a dict: Numba empties a dict of parallel options as it reads it,
+#: so a shared dict would leave every later kernel fully parallel.)
+NO_PARFORS = ParallelOptions({"prange": False, "numpy": False, "reduction": False, "setitem": False,
+                              "stencil": False, "comprehension": False, "fusion": False, "inplace_binop": False})
 
 
 def _quietly(compile_):
