@@ -72,8 +72,7 @@ def kernel(fn=None, **options):
 #: same operations, so the same bits. Used by the serial twins of
 #: :func:`threaded_and_serial` (a step's kernels on one thread, the limit surface's walk),
 #: a step's one-pass kernels and the limit surface's per-point kernels, whose outputs the
-#: tests check bit for bit; not everywhere: with every kernel under it, one of the limit
-#: surface's patch-cutting kernels computed something else (not found which construct).
+#: tests check bit for bit.
 #: (An options object, not a dict: Numba empties a dict of parallel options as it reads it,
 #: so a shared dict would leave every later kernel fully parallel.)
 NO_PARFORS = ParallelOptions({"prange": False, "numpy": False, "reduction": False, "setitem": False,
