@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
+from .._atomic import atomic_add
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._rules.refinement import (
     CORNER,
@@ -132,30 +133,45 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
 
     Each chunk of faces first counts its new points; the numbering then starts each chunk
     where the chunks before it end, so points are numbered as the serial pass numbers them.
-    The per-vertex numbers are gathered by vertex ranges (:func:`_count_range`).
+    An edge's owner writes its kind and point to its twin as well. Each chunk adds its own
+    edges' and faces' shares of the per-vertex counts atomically
+    (integers: any order gives the same totals); the sums of fractional sharpness, floats,
+    are gathered by vertex ranges in the serial order (:func:`_fraction_range`), when there
+    are any.
     """
     m = F.shape[0]
     n = counts.shape[1]
     sqrt3 = scheme == SCHEME_SQRT3
     edge_start = np.zeros(chunks + 1, np.int64)
     face_start = np.zeros(chunks + 1, np.int64)
+    fractional = np.zeros(chunks, np.bool_)
     for c in prange(chunks):
         new_e = 0
         new_f = 0
         for f in range(c * m // chunks, (c + 1) * m // chunks):
-            for h in range(3 * f, 3 * f + 3):
+            for i in range(3):
+                h = 3 * f + i
                 t = twin[h]
                 if t < 0 or t > h:
-                    k = _edge_kind(h, t, edge_sharpness(h, twin, hsharp, has_tags), face_sharp, force_split, sqrt3,
-                                   odd)
+                    s = edge_sharpness(h, twin, hsharp, has_tags)
+                    k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
                     hkind[h] = k
+                    if t >= 0:
+                        hkind[t] = k
                     new_e += _new_on_edge(k)
+                    _count_end_atomic(F[f, i], s, counts)
+                    _count_end_atomic(F[f, i + 1 if i < 2 else 0], s, counts)
+                    if 0.0 < s <= 1.0:
+                        fractional[c] = True
             has, trisected[f] = _face_has_point(f, twin, face_sharp, sqrt3, odd)
             new_f += 1 if has else 0
+            if mixed:
+                for i in range(3):
+                    atomic_add(counts[4], F[f, i], 1)
+                    if face_sharp[f]:
+                        atomic_add(counts[5], F[f, i], 1)
         edge_start[c + 1] = new_e
         face_start[c + 1] = new_f
-        _count_range(c * n // chunks, (c + 1) * n // chunks, F, twin, hsharp, has_tags, face_sharp, mixed, counts,
-                     s_frac)
     edge_start[0] = n
     for c in range(chunks):
         edge_start[c + 1] += edge_start[c]
@@ -171,47 +187,49 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
                 if t < 0 or t > h:
                     new = _new_on_edge(hkind[h])
                     edge_point[h] = nxt if new else -1
+                    if t >= 0:
+                        edge_point[t] = edge_point[h]
                     nxt += new
             has, _ = _face_has_point(f, twin, face_sharp, sqrt3, odd)
             face_point[f] = nfp if has else -1
             nfp += 1 if has else 0
-    for h in prange(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            hkind[h] = hkind[t]
-            edge_point[h] = edge_point[t]
+    if fractional.any():
+        for c in prange(chunks):
+            _fraction_range(c * n // chunks, (c + 1) * n // chunks, F, twin, hsharp, s_frac)
     return face_start[chunks]
 
 
 @kernel(inline="always")
-def _count_range(lo, hi, F, twin, hsharp, has_tags, face_sharp, mixed, counts, s_frac):
-    """:func:`classify_step`'s per-vertex numbers for the vertices ``lo:hi``: every edge is
-    walked and only those vertices' terms kept, so each sum runs in the serial order."""
-    valence = counts[0]
+def _count_end_atomic(v, s, counts):
+    """:func:`_count_end`'s integer counts, added atomically (other threads may count ``v``)."""
+    atomic_add(counts[0], v, 1)
+    if s > 0.0:
+        atomic_add(counts[1], v, 1)
+        if s > 1.0:
+            atomic_add(counts[2], v, 1)
+        else:
+            atomic_add(counts[3], v, 1)
+
+
+@kernel(inline="always")
+def _fraction_range(lo, hi, F, twin, hsharp, s_frac):
+    """:func:`classify_step`'s sums of fractional sharpness (0 < s ≤ 1, tagged edges only)
+    for the vertices ``lo:hi``: every edge is walked and only those vertices' terms kept, so
+    each sum runs in the serial order."""
     for f in range(F.shape[0]):
         for i in range(3):
             u, w, mine_u, mine_w = owned_ends_in(F, twin, f, i, lo, hi)
             if not (mine_u or mine_w):
                 continue
-            s = edge_sharpness(3 * f + i, twin, hsharp, has_tags)
-            if s == 0.0:  # most edges: the valences alone (the loop compiles tighter)
-                if mine_u:
-                    valence[np.uintp(u)] += 1
-                if mine_w:
-                    valence[np.uintp(w)] += 1
+            h = 3 * f + i
+            if twin[h] < 0:
                 continue
-            if mine_u:
-                _count_end(u, s, counts, s_frac)
-            if mine_w:
-                _count_end(w, s, counts, s_frac)
-    if mixed:
-        for f in range(F.shape[0]):
-            sh = 1 if face_sharp[f] else 0
-            for i in range(3):
-                v = F[f, i]
-                if lo <= v < hi:
-                    counts[4, v] += 1
-                    counts[5, v] += sh
+            s = hsharp[h]
+            if 0.0 < s <= 1.0:
+                if mine_u:
+                    s_frac[u] += s
+                if mine_w:
+                    s_frac[w] += s
 
 
 def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs, cn, fix_boundary,
