@@ -330,7 +330,7 @@ emit_faces, emit_faces_serial = threaded_and_serial(_emit_faces)
 
 
 @kernel(inline="always")
-def _prefetch_across(h0, twin, hkind, face_point, face_sharp, first):
+def _prefetch_faces_across(h0, twin, hkind, face_point, face_sharp, first):
     """Prefetch what :func:`_emit_topology` reads of the faces across face ``h0 // 3``'s
     edges (they lie anywhere in this level; each read waits on memory otherwise)."""
     for h in range(h0, h0 + 3):
@@ -350,7 +350,7 @@ def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sh
     fetch = far_twins(twin)
     for f in prange(m):
         if fetch and f + _FACES_AHEAD < m:
-            _prefetch_across(3 * (f + _FACES_AHEAD), twin, hkind, face_point, face_sharp, first)
+            _prefetch_faces_across(3 * (f + _FACES_AHEAD), twin, hkind, face_point, face_sharp, first)
         o = first[3 * f]
         if face_sharp[f]:
             for q in range(4):
