@@ -33,7 +33,7 @@ from ._halfedge_kernels import dest, far_twins, next_in_face, prev_in_face
 # Error codes of halfedge_twins.
 OK = 0
 ERR_SAME_DIRECTION = 1  # two halfedges u→w: non-manifold edge or inconsistent orientation
-ERR_MULTIPLE_TWINS = 2  # several halfedges w→u for one u→w
+ERR_MULTIPLE_TWINS = 2  # more than two halfedges on one edge
 
 #: Inputs smaller than this (faces or rows) run the serial twin of a threaded kernel:
 #: starting threads costs more than the work.
@@ -76,37 +76,74 @@ def group_by_origin(F, n_vertices):
     return by_origin, start
 
 
+#: Groups of halfedges (by lower end) longer than this are matched by sorting their keys
+#: instead of comparing every pair: a fan of many faces around one vertex stays n log n.
+_SORT_GROUP_FROM = 64
+
+
 @kernel(parallel=NO_PARFORS)
 def halfedge_twins(F, n_vertices):
-    """Twin of every halfedge (−1 on the boundary), and halfedges grouped by origin.
+    """Twin of every halfedge (−1 on the boundary).
 
-    Returns (twin, by_origin, origin_start, error, h_bad), the middle two as
-    :func:`group_by_origin` gives them. ``error`` is OK or an ERR_* code with the offending
-    halfedge ``h_bad``.
+    Returns (twin, error, h_bad): ``error`` is OK or an ERR_* code with the offending
+    halfedge ``h_bad`` (the messages are made from the faces, by ``errors``). The halfedges
+    are grouped by the lower-numbered end of their edge (a counting sort), so both halves of
+    an edge fall in one group, and each group is matched on its own, in order of memory:
+    the key of a halfedge is its edge's other end and whether it leaves the lower end.
     """
-    nh = 3 * F.shape[0]
-    by_origin, start = group_by_origin(F, n_vertices)
-    ends = np.empty(nh, np.int64)  # destination of by_origin[k], so every group scans contiguously
-    for k in range(nh):
-        ends[k] = dest(F, by_origin[k])
+    m = F.shape[0]
+    nh = 3 * m
+    start = np.zeros(n_vertices + 1, np.int64)
+    for f in range(m):
+        for i in range(3):
+            start[min(F[f, i], F[f, i + 1 if i < 2 else 0]) + 1] += 1
+    for v in range(n_vertices):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    key = np.empty(nh, np.int64)
+    half = np.empty(nh, np.int64)
+    for f in range(m):
+        for i in range(3):
+            u = F[f, i]
+            w = F[f, i + 1 if i < 2 else 0]
+            lo = min(u, w)
+            k = fill[lo]
+            fill[lo] = k + 1
+            key[k] = 2 * max(u, w) + (1 if u < w else 0)
+            half[k] = 3 * f + i
     twin = np.full(nh, -1, np.int64)
-    for u in range(n_vertices):
-        for k in range(start[u], start[u + 1]):
-            w = ends[k]
-            h = by_origin[k]
-            for q in range(k + 1, start[u + 1]):
-                if ends[q] == w:
-                    return twin, by_origin, start, ERR_SAME_DIRECTION, h
-            if twin[h] >= 0:
-                continue
-            for q in range(start[w], start[w + 1]):
-                if ends[q] == u:
-                    g = by_origin[q]
-                    if twin[h] >= 0:
-                        return twin, by_origin, start, ERR_MULTIPLE_TWINS, h
-                    twin[h] = g
-                    twin[g] = h
-    return twin, by_origin, start, OK, -1
+    for v in range(n_vertices):
+        a = start[v]
+        b = start[v + 1]
+        if b - a > _SORT_GROUP_FROM:
+            order = np.argsort(key[a:b], kind="mergesort")
+            key[a:b] = key[a:b][order]
+            half[a:b] = half[a:b][order]
+            for k in range(a, b - 1):
+                if key[k] >> 1 == key[k + 1] >> 1:
+                    err = _pair(twin, key[k], half[k], key[k + 1], half[k + 1])
+                    if err != OK:
+                        return twin, err, half[k]
+            continue
+        for k in range(a, b):
+            for q in range(k + 1, b):
+                if key[q] >> 1 == key[k] >> 1:
+                    err = _pair(twin, key[k], half[k], key[q], half[q])
+                    if err != OK:
+                        return twin, err, half[k]
+    return twin, OK, -1
+
+
+@kernel(inline="always")
+def _pair(twin, key_h, h, key_g, g):
+    """Make halfedges h and g of one edge twins, or say why they cannot be."""
+    if key_h == key_g:
+        return ERR_SAME_DIRECTION
+    if twin[h] >= 0 or twin[g] >= 0:
+        return ERR_MULTIPLE_TWINS
+    twin[h] = g
+    twin[g] = h
+    return OK
 
 
 @kernel

@@ -135,10 +135,10 @@ def build_level(faces: np.ndarray, n_vertices: int) -> Level:
     vertex within a face.
     """
     F = np.ascontiguousarray(faces, dtype=np.int64)
-    twin, by_origin, origin_start, err, _ = K.halfedge_twins(F, n_vertices)
+    twin, err, _ = K.halfedge_twins(F, n_vertices)
     if err != K.OK:
         raise topology_error(F) or MeshError("the mesh is not an oriented edge-manifold")
-    return Level(F, n_vertices, twin, by_origin=(by_origin, origin_start))
+    return Level(F, n_vertices, twin)
 
 
 def checked_level(F: np.ndarray, n: int, pairs: np.ndarray | None = None) -> Level:
