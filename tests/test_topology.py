@@ -39,19 +39,22 @@ def _twins_by_dictionary(F):
 def test_searched_twins_equal_a_dictionary_of_edges(data, rng):
     """The input's twin search (halfedges grouped by their edge's lower end, a group of more
     than 64 matched by sorting) pairs exactly the halfedges a dictionary pairs, whatever the
-    vertex numbering (the fan centre first, last or between); a face flipped against its
-    neighbours makes two halfedges run the same way, which it reports."""
+    vertex numbering (the fan centre first, last or between), with int32 scratch and with
+    the int64 kept for meshes beyond it; a face flipped against its neighbours makes two
+    halfedges run the same way, which it reports."""
     V, F, _ = data
     F = np.ascontiguousarray(rng.permutation(len(V))[F])
-    twin, err, _ = K.halfedge_twins(F, len(V))
+    twin, err = K.twin_search(F, len(V))
     assert err == K.OK
     assert np.array_equal(twin, _twins_by_dictionary(F))
+    wide = np.empty(3 * len(F), np.int64), np.empty(3 * len(F), np.int64), np.empty(3 * len(F), np.int64)
+    assert K.halfedge_twins(F, len(V), *wide)[0] == K.OK and np.array_equal(wide[0], twin)  # beyond int32
     inner = np.flatnonzero((twin.reshape(-1, 3) >= 0).all(axis=1))
     if len(inner):
         flipped = F.copy()
         flipped[inner[0]] = flipped[inner[0], ::-1]
         if _twins_by_dictionary(flipped) is None:
-            assert K.halfedge_twins(flipped, len(V))[1] != K.OK
+            assert K.twin_search(flipped, len(V))[1] != K.OK
 
 
 @SETTINGS
@@ -59,7 +62,7 @@ def test_searched_twins_equal_a_dictionary_of_edges(data, rng):
 def test_derived_twins_equal_searched_twins(data, scheme, levels):
     V, F, tags = data
     for level, plan, faces, child, offsets in _levels(V, F, tags, scheme, levels):
-        twin, err, _ = K.halfedge_twins(child.faces, child.n_vertices)
+        twin, err = K.twin_search(child.faces, child.n_vertices)
         assert err == K.OK
         assert np.array_equal(child.twin, twin)
 
@@ -70,7 +73,7 @@ def test_derived_twins_equal_searched_twins_sqrt3(data, levels):
     """Kobbelt's boundary: odd steps keep, even steps trisect; all twins still agree."""
     V, F, _ = data
     for level, plan, faces, child, offsets in _levels(V, F, {}, "sqrt3", levels):
-        twin, err, _ = K.halfedge_twins(child.faces, child.n_vertices)
+        twin, err = K.twin_search(child.faces, child.n_vertices)
         assert err == K.OK
         assert np.array_equal(child.twin, twin)
 

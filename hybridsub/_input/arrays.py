@@ -125,8 +125,8 @@ def as_vertices(V, return_dtype: bool = False):
         raise MeshError(f"V must have shape (n, 3), got {A.shape}{hint}")
     dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.dtype(np.float64)
     A = writable(np.ascontiguousarray(A, dtype=np.float64))
-    bad = ~np.isfinite(A).all(axis=1)
-    if bad.any():
+    if not np.isfinite(A).all():  # (a row-wise reduction only to name the vertex: 30× slower)
+        bad = ~np.isfinite(A).all(axis=1)
         i = int(np.flatnonzero(bad)[0])
         raise MeshError(f"vertex {i} has a non-finite coordinate {A[i].tolist()} ({int(bad.sum())} such vertices)")
     return (A, dtype) if return_dtype else A
@@ -173,9 +173,8 @@ def as_faces(F, n_vertices: int | None) -> tuple[np.ndarray, int]:
             f = int(np.flatnonzero(frac)[0])
             raise MeshError(f"F must hold integer vertex indices; face {f} is {A[f].tolist()}")
     if A.size:
-        neg = (A < 0).any(axis=1)
-        if neg.any():
-            f = int(np.flatnonzero(neg)[0])
+        if A.min() < 0:
+            f = int(np.flatnonzero((A < 0).any(axis=1))[0])
             raise MeshError(f"face {f} = {A[f].tolist()} has a negative vertex index")
         top = A.max()
         limit = n_vertices if n_vertices is not None else 2**62
@@ -328,9 +327,8 @@ def as_uv_faces(FUV, m: int, n_uvs: int | None, name: str = "FUV") -> np.ndarray
             raise MeshError(f"{name} must hold integer UV indices; face {f} has {A[f].tolist()}")
     T = np.ascontiguousarray(A, dtype=np.int64)
     if T.size:
-        neg = (T < 0).any(axis=1)
-        if neg.any():
-            f = int(np.flatnonzero(neg)[0])
+        if T.min() < 0:
+            f = int(np.flatnonzero((T < 0).any(axis=1))[0])
             raise MeshError(f"{name}: face {f} has a negative UV index: {T[f].tolist()}")
         if n_uvs is not None and T.max() >= n_uvs:
             f = int(np.flatnonzero((T >= n_uvs).any(axis=1))[0])
@@ -347,8 +345,7 @@ def as_uv_values(UV) -> np.ndarray:
     if A.ndim not in (1, 2):
         raise MeshError(f"UV must have shape (t, k) (one row per UV value), got {A.shape}")
     A = np.ascontiguousarray(A, dtype=np.float64)
-    bad = ~np.isfinite(A.reshape(len(A), -1)).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    if not np.isfinite(A).all():
+        i = int(np.flatnonzero(~np.isfinite(A.reshape(len(A), -1)).all(axis=1))[0])
         raise MeshError(f"UV value {i} is not finite: {A[i].tolist()}")
     return A

@@ -82,17 +82,17 @@ _SORT_GROUP_FROM = 64
 
 
 @kernel(parallel=NO_PARFORS)
-def halfedge_twins(F, n_vertices):
-    """Twin of every halfedge (−1 on the boundary).
+def halfedge_twins(F, n_vertices, twin, key, half):
+    """Fill ``twin`` (3m,) with the twin of every halfedge (−1 on the boundary).
 
-    Returns (twin, error, h_bad): ``error`` is OK or an ERR_* code with the offending
-    halfedge ``h_bad`` (the messages are made from the faces, by ``errors``). The halfedges
-    are grouped by the lower-numbered end of their edge (a counting sort), so both halves of
-    an edge fall in one group, and each group is matched on its own, in order of memory:
-    the key of a halfedge is its edge's other end and whether it leaves the lower end.
+    ``key`` and ``half`` (3m,) are scratch (int32 where the indices fit). Returns (error,
+    h_bad): OK or an ERR_* code with the offending halfedge (the messages are made from the
+    faces, by ``errors``). The halfedges are grouped by the lower-numbered end of their edge
+    (a counting sort), so both halves of an edge fall in one group, and each group is matched
+    on its own, in memory order: a halfedge's key is its edge's other end and whether it
+    leaves the lower end.
     """
     m = F.shape[0]
-    nh = 3 * m
     start = np.zeros(n_vertices + 1, np.int64)
     for f in range(m):
         for i in range(3):
@@ -100,8 +100,6 @@ def halfedge_twins(F, n_vertices):
     for v in range(n_vertices):
         start[v + 1] += start[v]
     fill = start[:-1].copy()
-    key = np.empty(nh, np.int64)
-    half = np.empty(nh, np.int64)
     for f in range(m):
         for i in range(3):
             u = F[f, i]
@@ -111,7 +109,7 @@ def halfedge_twins(F, n_vertices):
             fill[lo] = k + 1
             key[k] = 2 * max(u, w) + (1 if u < w else 0)
             half[k] = 3 * f + i
-    twin = np.full(nh, -1, np.int64)
+    twin[:] = -1
     for v in range(n_vertices):
         a = start[v]
         b = start[v + 1]
@@ -123,15 +121,27 @@ def halfedge_twins(F, n_vertices):
                 if key[k] >> 1 == key[k + 1] >> 1:
                     err = _pair(twin, key[k], half[k], key[k + 1], half[k + 1])
                     if err != OK:
-                        return twin, err, half[k]
+                        return err, half[k]
             continue
         for k in range(a, b):
             for q in range(k + 1, b):
                 if key[q] >> 1 == key[k] >> 1:
                     err = _pair(twin, key[k], half[k], key[q], half[q])
                     if err != OK:
-                        return twin, err, half[k]
-    return twin, OK, -1
+                        return err, half[k]
+    return OK, -1
+
+
+def twin_search(F: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
+    """:func:`halfedge_twins` with its arrays allocated by NumPy (huge pages for big ones);
+    returns (twin, error)."""
+    nh = 3 * F.shape[0]
+    small = 2 * n_vertices + 1 < 2**31 and nh < 2**31
+    key = np.empty(nh, np.int32 if small else np.int64)
+    half = np.empty(nh, np.int32 if small else np.int64)
+    twin = np.empty(nh, np.int64)
+    err, _ = halfedge_twins(F, n_vertices, twin, key, half)
+    return twin, err
 
 
 @kernel(inline="always")
@@ -144,6 +154,19 @@ def _pair(twin, key_h, h, key_g, g):
     twin[h] = g
     twin[g] = h
     return OK
+
+
+@kernel(parallel=NO_PARFORS)
+def first_pillow(twin):
+    """The first face whose three edges all lie in one other face (with it, a closed
+    two-triangle "pillow": a duplicate face of opposite orientation), or −1."""
+    for f in range(twin.shape[0] // 3):
+        a = twin[3 * f]
+        b = twin[3 * f + 1]
+        c = twin[3 * f + 2]
+        if a >= 0 and b >= 0 and c >= 0 and a // 3 == b // 3 and b // 3 == c // 3:
+            return f
+    return -1
 
 
 @kernel

@@ -135,7 +135,7 @@ def build_level(faces: np.ndarray, n_vertices: int) -> Level:
     vertex within a face.
     """
     F = np.ascontiguousarray(faces, dtype=np.int64)
-    twin, err, _ = K.halfedge_twins(F, n_vertices)
+    twin, err = K.twin_search(F, n_vertices)
     if err != K.OK:
         raise topology_error(F) or MeshError("the mesh is not an oriented edge-manifold")
     return Level(F, n_vertices, twin)
@@ -148,14 +148,10 @@ def checked_level(F: np.ndarray, n: int, pairs: np.ndarray | None = None) -> Lev
     each), and sharp edges (``pairs``) that are not edges of the mesh.
     """
     level = build_level(F, n)
-    if level.n_faces:
-        t = level.twin.reshape(-1, 3)
-        tf = t // 3
-        # A face whose three edges all lie in the same other face: a duplicate with opposite
-        # orientation, the two making a closed two-triangle "pillow" the twin search accepts.
-        pillow = (t >= 0).all(axis=1) & (tf[:, 0] == tf[:, 1]) & (tf[:, 1] == tf[:, 2])
-        if pillow.any():
-            raise duplicate_faces_error(F)
+    # A face whose three edges all lie in the same other face: a duplicate with opposite
+    # orientation, the two making a closed two-triangle "pillow" the twin search accepts.
+    if K.first_pillow(level.twin) >= 0:
+        raise duplicate_faces_error(F)
     if pairs is not None and len(pairs):
         eid = level.find_edges(pairs)
         missing = (eid < 0) | (pairs[:, 0] == pairs[:, 1])
