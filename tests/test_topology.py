@@ -200,6 +200,31 @@ def test_classification_in_chunks_sums_fractional_sharpness_in_the_serial_order(
         assert a.tobytes() == b.tobytes()
 
 
+@SETTINGS
+@given(tagged_meshes("any"), st.sampled_from(["hybrid", "loop", "sqrt3"]), st.integers(1, 3))
+def test_step_counts_equal_counting_the_masks(data, scheme, levels):
+    """The budget's counts of a step, in one pass, equal the counts of its masks: boundary
+    halfedges, split and trisected edges (an interior edge once), split halfedges of smooth
+    faces, sharp faces and face points."""
+    from hybridsub._rules import refinement as R
+
+    V, F, tags = data
+    if scheme == "sqrt3":
+        tags = {}
+    for level, plan, faces, child, offsets in _levels(V, F, tags, scheme, levels):
+        out = np.empty(6, np.int64)
+        K.step_counts(level.twin, plan.hkind, level.face_sharp, plan.face_point, out)
+        boundary = level.twin < 0
+
+        def edges(mask):
+            return np.count_nonzero(mask & boundary) + np.count_nonzero(mask & ~boundary) // 2
+
+        split, trisect = plan.hkind == R.EDGE_SPLIT, plan.hkind == R.EDGE_TRISECT
+        assert out.tolist() == [np.count_nonzero(boundary), edges(split), edges(trisect),
+                                    np.count_nonzero(split.reshape(-1, 3)[~level.face_sharp]),
+                                    np.count_nonzero(level.face_sharp), np.count_nonzero(plan.face_point >= 0)]
+
+
 def test_far_twins_tells_scattered_faces_from_ordered_ones():
     """Prefetching across edges is switched on by far_twins: a grid written row by row has
     its faces across edges close by, the same grid with its faces shuffled far away."""

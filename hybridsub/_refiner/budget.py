@@ -41,7 +41,7 @@ from . import stencils as _stencils
 from ._stencil_kernels import product_bound
 from .._errors import OutputTooLargeError
 from .._input import count_of
-from .._topology import edge_keys, undirected_edges
+from .._topology import edge_keys, step_counts, undirected_edges
 from .._units import bytes_and_count, fmt_bytes
 from .._typing import MemoryLimit
 
@@ -244,21 +244,11 @@ class Estimate:
 
 def counts_of(level, plan) -> Counts:
     """Exact counts of a level and of the step ``plan`` (from ``_topology.plan_step``)."""
-    m = level.n_faces
-    boundary_he = level.twin < 0
-    split = plan.hkind == R.EDGE_SPLIT
-    trisect = plan.hkind == R.EDGE_TRISECT
-    smooth = ~level.face_sharp
-
-    def n_edges(mask):  # an interior edge has two halfedges, a boundary edge one
-        return int(np.count_nonzero(mask & boundary_he)) + int(np.count_nonzero(mask & ~boundary_he)) // 2
-
-    incid = int(np.count_nonzero(split.reshape(m, 3)[smooth])) if m else 0
-    return Counts(
-        n=level.n_vertices, m=m, sharp=int(np.count_nonzero(level.face_sharp)),
-        boundary=int(np.count_nonzero(boundary_he)), split=n_edges(split), trisect=n_edges(trisect),
-        incid=incid, face_points=int(np.count_nonzero(plan.face_point >= 0)),
-    )
+    c = np.empty(6, np.int64)
+    step_counts(level.twin, plan.hkind, level.face_sharp, plan.face_point, c)
+    boundary, split, trisect, incid, sharp, face_points = (int(x) for x in c)
+    return Counts(n=level.n_vertices, m=level.n_faces, sharp=sharp, boundary=boundary, split=split, trisect=trisect,
+                  incid=incid, face_points=face_points)
 
 
 def _next(c: Counts, scheme: str, step: int) -> Counts:

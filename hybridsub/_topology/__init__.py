@@ -4,7 +4,7 @@ tags, never positions. Other layers import from here, never from the modules ins
 
 from ._halfedge_kernels import (dest, edge_sharpness, far_twins, next_in_face, opposite, origin, owned_ends_in,
                                 prev_in_face)
-from ._kernels import group_by_origin, use_threads
+from ._kernels import group_by_origin, step_counts, use_threads
 from .cut import Cut, cut_non_manifold, map_sharp_edges
 from .edges import (EdgeGroups, UndirectedEdges, edge_keys, group_halfedges, halfedge_ends, next_halfedge,
                     prev_halfedge, undirected_edges)
@@ -19,5 +19,5 @@ __all__ = ["Cut", "EdgeGroups", "Level", "Sectors", "StepPlan", "UndirectedEdges
            "child_creases", "child_level", "cut_non_manifold", "dest", "duplicate_faces_error", "edge_keys",
            "edge_sharpness", "face_parents", "far_twins", "group_by_origin", "group_halfedges", "halfedge_ends", "linear_rows", "map_sharp_edges",
            "next_halfedge", "next_in_face", "not_an_edge_error", "opposite", "origin", "owned_ends_in", "plan_step", "prev_halfedge",
-           "prev_in_face", "seam_halfedges", "step_arguments", "topology_error", "undirected_edges", "use_threads",
+           "prev_in_face", "seam_halfedges", "step_arguments", "step_counts", "topology_error", "undirected_edges", "use_threads",
            "uv_start", "vertex_sectors"]

@@ -56,11 +56,11 @@ def use_threads(rows: int) -> bool:
 
 
 @kernel(parallel=NO_PARFORS)
-def group_by_origin(F, n_vertices):
-    """Halfedges grouped by origin vertex (a counting sort): ``by_origin[start[v]:start[v+1]]``
-    are the halfedges leaving v, in increasing order. Returns (by_origin, start)."""
+def fill_by_origin(F, n_vertices, by_origin):
+    """Group the halfedges by origin vertex (a counting sort) into ``by_origin`` (3m,):
+    ``by_origin[start[v]:start[v+1]]`` are the halfedges leaving v, in increasing order.
+    Returns ``start`` (n + 1,)."""
     m = F.shape[0]
-    nh = 3 * m
     start = np.zeros(n_vertices + 1, np.int64)
     for f in range(m):
         for i in range(3):
@@ -68,12 +68,19 @@ def group_by_origin(F, n_vertices):
     for v in range(n_vertices):
         start[v + 1] += start[v]
     fill = start[:-1].copy()
-    by_origin = np.empty(nh, np.int64)
-    for h in range(nh):
-        u = F[h // 3, h % 3]
-        by_origin[fill[u]] = h
-        fill[u] += 1
-    return by_origin, start
+    for f in range(m):
+        for i in range(3):
+            u = F[f, i]
+            by_origin[fill[u]] = 3 * f + i
+            fill[u] += 1
+    return start
+
+
+@kernel(parallel=NO_PARFORS)
+def group_by_origin(F, n_vertices):
+    """:func:`fill_by_origin` into a new array, for kernels; returns (by_origin, start)."""
+    by_origin = np.empty(3 * F.shape[0], np.int64)
+    return by_origin, fill_by_origin(F, n_vertices, by_origin)
 
 
 #: Groups of halfedges (by lower end) longer than this are matched by sorting their keys
@@ -195,14 +202,12 @@ def find_halfedges(pairs, F, by_origin, origin_start):
     return out
 
 
-@kernel
-def number_edges(twin):
-    """Edge of each halfedge and owner halfedge of each edge, edges in owner order."""
-    nh = twin.shape[0]
-    edge_of = np.empty(nh, np.int64)
-    owner = np.empty(nh, np.int64)
+@kernel(parallel=NO_PARFORS)
+def number_edges(twin, edge_of, owner):
+    """Fill the edge of each halfedge (``edge_of``, 3m) and the owner halfedge of each edge
+    (``owner[:ne]``), edges in owner order; returns the number of edges ``ne``."""
     ne = 0
-    for h in range(nh):
+    for h in range(twin.shape[0]):
         t = twin[h]
         if t < 0 or h < t:
             edge_of[h] = ne
@@ -210,7 +215,32 @@ def number_edges(twin):
             ne += 1
         else:
             edge_of[h] = edge_of[t]
-    return edge_of, owner[:ne].copy()
+    return ne
+
+
+@kernel(parallel=NO_PARFORS)
+def step_counts(twin, hkind, face_sharp, face_point, out):
+    """What a step makes, in one pass: ``out`` (6,) int64 receives the boundary halfedges,
+    the split edges, the trisected edges (an interior edge counted once), the split halfedges
+    of smooth faces, the sharp faces and the face points."""
+    out[:] = 0
+    for h in range(twin.shape[0]):
+        k = hkind[h]
+        inner = twin[h] >= 0
+        if not inner:
+            out[0] += 1
+        if k == EDGE_SPLIT:
+            if not inner or twin[h] > h:
+                out[1] += 1
+            if not face_sharp[h // 3]:
+                out[3] += 1
+        elif k == EDGE_TRISECT and (not inner or twin[h] > h):
+            out[2] += 1
+    for f in range(face_sharp.shape[0]):
+        if face_sharp[f]:
+            out[4] += 1
+        if face_point[f] >= 0:
+            out[5] += 1
 
 
 @kernel

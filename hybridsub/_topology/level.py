@@ -52,7 +52,9 @@ class Level:
 
     @cached_property
     def _edges(self):
-        return K.number_edges(self.twin)
+        edge_of = np.empty(len(self.twin), np.int64)  # NumPy's pages: huge ones for big levels
+        owner = np.empty(len(self.twin), np.int64)
+        return edge_of, owner[:K.number_edges(self.twin, edge_of, owner)].copy()
 
     @property
     def edge_of(self) -> np.ndarray:
@@ -96,7 +98,8 @@ class Level:
 
     def _origin_groups(self):
         if self._by_origin is None:
-            self._by_origin = K.group_by_origin(self.faces, self.n_vertices)
+            by_origin = np.empty(3 * self.n_faces, np.int64)
+            self._by_origin = by_origin, K.fill_by_origin(self.faces, self.n_vertices, by_origin)
         return self._by_origin
 
     def find_halfedges(self, pairs: np.ndarray) -> np.ndarray:
