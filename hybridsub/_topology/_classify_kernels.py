@@ -27,7 +27,7 @@ from .._rules.refinement import (
     vertex_mask,
     vertex_rule,
 )
-from ._halfedge_kernels import dest, edge_sharpness, origin, owned_ends_in
+from ._halfedge_kernels import edge_sharpness, owned_ends_in
 
 
 @kernel(inline="always")
@@ -99,20 +99,22 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, sch
     n = counts.shape[1]
     sqrt3 = scheme == SCHEME_SQRT3
     nxt = n
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            hkind[h] = hkind[t]
-            edge_point[h] = edge_point[t]
-            continue
-        s = edge_sharpness(h, twin, hsharp, has_tags)
-        k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
-        hkind[h] = k
-        new = _new_on_edge(k)
-        edge_point[h] = nxt if new else -1
-        nxt += new
-        _count_end(origin(F, h), s, counts, s_frac)
-        _count_end(dest(F, h), s, counts, s_frac)
+    for f in range(m):  # face by face: a face's corners without dividing halfedges by 3
+        for i in range(3):
+            h = 3 * f + i
+            t = twin[h]
+            if t >= 0 and t < h:
+                hkind[h] = hkind[t]
+                edge_point[h] = edge_point[t]
+                continue
+            s = edge_sharpness(h, twin, hsharp, has_tags)
+            k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
+            hkind[h] = k
+            new = _new_on_edge(k)
+            edge_point[h] = nxt if new else -1
+            nxt += new
+            _count_end(F[f, i], s, counts, s_frac)
+            _count_end(F[f, i + 1 if i < 2 else 0], s, counts, s_frac)
     for f in range(m):
         has, trisected[f] = _face_has_point(f, twin, face_sharp, sqrt3, odd)
         face_point[f] = nxt if has else -1
