@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, threaded_and_serial
+from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
 from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_ends_in
@@ -212,7 +212,7 @@ def _face_point_row(f, X, F, face_point, out):
 apply_step, apply_step_serial = threaded_and_serial(_apply_step)
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
     """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
     n = coef.shape[1]
@@ -220,25 +220,27 @@ def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, c
     n_new = indptr.shape[0] - 1
     for v in range(n):
         indptr[v + 1] = 1
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = origin(F, h)
-        w = dest(F, h)
-        s = edge_sharpness(h, twin, hsharp, has_tags)
-        if _neighbour_coefficient(u, s, coef) != 0.0:
-            indptr[u + 1] += 1
-        if _neighbour_coefficient(w, s, coef) != 0.0:
-            indptr[w + 1] += 1
-        r = edge_point[h]
-        if r < 0:
-            continue
-        if hkind[h] == EDGE_TRISECT:
-            indptr[r + 1] = 3
-            indptr[r + 2] = 3
-        else:
-            indptr[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
+    for f in range(m):
+        for i in range(3):
+            h = 3 * f + i
+            t = twin[h]
+            if t >= 0 and t < h:
+                continue
+            u = F[f, i]
+            w = F[f, i + 1 if i < 2 else 0]
+            s = edge_sharpness(h, twin, hsharp, has_tags)
+            if _neighbour_coefficient(u, s, coef) != 0.0:
+                indptr[u + 1] += 1
+            if _neighbour_coefficient(w, s, coef) != 0.0:
+                indptr[w + 1] += 1
+            r = edge_point[h]
+            if r < 0:
+                continue
+            if hkind[h] == EDGE_TRISECT:
+                indptr[r + 1] = 3
+                indptr[r + 2] = 3
+            else:
+                indptr[r + 1] = 2 if edge_weights(s)[1] == 0.0 else 4
     for f in range(m):
         if face_point[f] >= 0:
             indptr[face_point[f] + 1] = 3
@@ -246,7 +248,7 @@ def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, c
         indptr[r + 1] += indptr[r]
 
 
-@kernel
+@kernel(parallel=NO_PARFORS)
 def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr,
                 indices, data):
     """Fill the CSR ``indices`` and ``data`` of the step's matrix, rows in apply_step's order."""
@@ -257,51 +259,28 @@ def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, 
         indices[fill[v]] = v
         data[fill[v]] = coef[0, v]
         fill[v] += 1
-    for h in range(3 * m):
-        t = twin[h]
-        if t >= 0 and t < h:
-            continue
-        u = origin(F, h)
-        w = dest(F, h)
-        s = edge_sharpness(h, twin, hsharp, has_tags)
-        c = _neighbour_coefficient(u, s, coef)
-        if c != 0.0:
-            indices[fill[u]] = w
-            data[fill[u]] = c
-            fill[u] += 1
-        c = _neighbour_coefficient(w, s, coef)
-        if c != 0.0:
-            indices[fill[w]] = u
-            data[fill[w]] = c
-            fill[w] += 1
-        r = edge_point[h]
-        if r < 0:
-            continue
-        q = indptr[r]
-        if hkind[h] == EDGE_TRISECT:
-            indices[q] = origin(F, bprev[h])
-            indices[q + 1] = u
-            indices[q + 2] = w
-            indices[q + 3] = u
-            indices[q + 4] = w
-            indices[q + 5] = dest(F, bnext[h])
-            data[q] = _T0
-            data[q + 1] = _T1
-            data[q + 2] = _T2
-            data[q + 3] = _T2
-            data[q + 4] = _T1
-            data[q + 5] = _T0
-            continue
-        wab, wcd = edge_weights(s)
-        indices[q] = u
-        indices[q + 1] = w
-        data[q] = wab
-        data[q + 1] = wab
-        if wcd != 0.0:
-            indices[q + 2] = opposite(F, h)
-            indices[q + 3] = opposite(F, t)
-            data[q + 2] = wcd
-            data[q + 3] = wcd
+    for f in range(m):
+        for i in range(3):
+            h = 3 * f + i
+            t = twin[h]
+            if t >= 0 and t < h:
+                continue
+            u = F[f, i]
+            w = F[f, i + 1 if i < 2 else 0]
+            s = edge_sharpness(h, twin, hsharp, has_tags)
+            c = _neighbour_coefficient(u, s, coef)
+            if c != 0.0:
+                indices[fill[u]] = w
+                data[fill[u]] = c
+                fill[u] += 1
+            c = _neighbour_coefficient(w, s, coef)
+            if c != 0.0:
+                indices[fill[w]] = u
+                data[fill[w]] = c
+                fill[w] += 1
+            r = edge_point[h]
+            if r >= 0:
+                _fill_edge_row(indptr[r], h, u, w, s, F, twin, hkind, bnext, bprev, indices, data)
     for f in range(m):
         r = face_point[f]
         if r >= 0:
@@ -309,6 +288,35 @@ def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, 
             for i in range(3):
                 indices[q + i] = F[f, i]
                 data[q + i] = _THIRD
+
+
+@kernel(inline="always")
+def _fill_edge_row(q, h, u, w, s, F, twin, hkind, bnext, bprev, indices, data):
+    """The CSR entries, from ``q``, of the edge point(s) of halfedge ``h`` = u→w."""
+    if hkind[h] == EDGE_TRISECT:
+        indices[q] = origin(F, bprev[h])
+        indices[q + 1] = u
+        indices[q + 2] = w
+        indices[q + 3] = u
+        indices[q + 4] = w
+        indices[q + 5] = dest(F, bnext[h])
+        data[q] = _T0
+        data[q + 1] = _T1
+        data[q + 2] = _T2
+        data[q + 3] = _T2
+        data[q + 4] = _T1
+        data[q + 5] = _T0
+        return
+    wab, wcd = edge_weights(s)
+    indices[q] = u
+    indices[q + 1] = w
+    data[q] = wab
+    data[q + 1] = wab
+    if wcd != 0.0:
+        indices[q + 2] = opposite(F, h)
+        indices[q + 3] = opposite(F, twin[h])
+        data[q + 2] = wcd
+        data[q + 3] = wcd
 
 
 def _csr_apply(indptr, indices, data, X, out):
