@@ -212,6 +212,15 @@ def _face_point_row(f, X, F, face_point, out):
 apply_step, apply_step_serial = threaded_and_serial(_apply_step)
 
 
+@kernel(inline="always")
+def _owned_edge(F, twin, f, i):
+    """(h, u, w): halfedge ``h = 3 f + i`` and its ends u → w if it owns its edge, else h = −1
+    (face and corner in: no division by 3)."""
+    h = 3 * f + i
+    t = twin[h]
+    return h if t < 0 or t > h else -1, F[f, i], F[f, i + 1 if i < 2 else 0]
+
+
 @kernel(parallel=NO_PARFORS)
 def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
     """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
@@ -222,12 +231,9 @@ def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, c
         indptr[v + 1] = 1
     for f in range(m):
         for i in range(3):
-            h = 3 * f + i
-            t = twin[h]
-            if t >= 0 and t < h:
+            h, u, w = _owned_edge(F, twin, f, i)
+            if h < 0:
                 continue
-            u = F[f, i]
-            w = F[f, i + 1 if i < 2 else 0]
             s = edge_sharpness(h, twin, hsharp, has_tags)
             if _neighbour_coefficient(u, s, coef) != 0.0:
                 indptr[u + 1] += 1
@@ -261,12 +267,9 @@ def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, 
         fill[v] += 1
     for f in range(m):
         for i in range(3):
-            h = 3 * f + i
-            t = twin[h]
-            if t >= 0 and t < h:
+            h, u, w = _owned_edge(F, twin, f, i)
+            if h < 0:
                 continue
-            u = F[f, i]
-            w = F[f, i + 1 if i < 2 else 0]
             s = edge_sharpness(h, twin, hsharp, has_tags)
             c = _neighbour_coefficient(u, s, coef)
             if c != 0.0:

@@ -55,6 +55,15 @@ def use_threads(rows: int) -> bool:
 # Topology of an input mesh (level 0). Later levels get their twins from emit_topology.
 
 
+@kernel(inline="always")
+def _group_starts(start):
+    """A counting sort's group starts from its counts: ``start`` (holding each group's size
+    at ``start[g + 1]``) summed in place; returns a copy of the starts to fill from."""
+    for g in range(start.shape[0] - 1):
+        start[g + 1] += start[g]
+    return start[:-1].copy()
+
+
 @kernel(parallel=NO_PARFORS)
 def fill_by_origin(F, n_vertices, by_origin):
     """Group the halfedges by origin vertex (a counting sort) into ``by_origin`` (3m,):
@@ -65,9 +74,7 @@ def fill_by_origin(F, n_vertices, by_origin):
     for f in range(m):
         for i in range(3):
             start[F[f, i] + 1] += 1
-    for v in range(n_vertices):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
+    fill = _group_starts(start)
     for f in range(m):
         for i in range(3):
             u = F[f, i]
@@ -104,9 +111,7 @@ def halfedge_twins(F, n_vertices, twin, key, half):
     for f in range(m):
         for i in range(3):
             start[min(F[f, i], F[f, i + 1 if i < 2 else 0]) + 1] += 1
-    for v in range(n_vertices):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
+    fill = _group_starts(start)
     for f in range(m):
         for i in range(3):
             u = F[f, i]
