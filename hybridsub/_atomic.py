@@ -30,7 +30,8 @@ from numba.extending import intrinsic
 
 @intrinsic
 def atomic_add(typingctx, x, at, value):
-    """``x[at] += value`` for a 1-D integer array ``x``, atomically (``at`` not checked)."""
+    """``x[at] += value`` for a 1-D integer array ``x``, atomically (``at`` not checked);
+    returns what ``x[at]`` held before (so threads adding 1 each get a slot of their own)."""
     if not (isinstance(x, types.Array) and x.ndim == 1 and isinstance(x.dtype, types.Integer)
             and isinstance(at, types.Integer) and isinstance(value, types.Integer)):
         return None
@@ -41,11 +42,13 @@ def atomic_add(typingctx, x, at, value):
         index = context.cast(builder, args[1], at_type, types.intp)
         address = cgutils.get_item_pointer(context, builder, array_type, array, [index], wraparound=False,
                                            boundscheck=False)
-        builder.atomic_rmw("add", address, context.cast(builder, args[2], value_type, array_type.dtype), "monotonic")
-        return context.get_dummy_value()
-    return types.void(x, at, value), codegen
+        return builder.atomic_rmw("add", address, context.cast(builder, args[2], value_type, array_type.dtype),
+                                  "monotonic")
+    return x.dtype(x, at, value), codegen
 
 
 if config.DISABLE_JIT:  # the kernels run as Python, on one thread
     def atomic_add(x, at, value):  # noqa: F811
+        old = x[at]
         x[at] += value
+        return old

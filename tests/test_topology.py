@@ -40,8 +40,8 @@ def test_searched_twins_equal_a_dictionary_of_edges(data, rng):
     """The input's twin search (halfedges grouped by their edge's lower end, a group of more
     than 64 matched by sorting) pairs exactly the halfedges a dictionary pairs, whatever the
     vertex numbering (the fan centre first, last or between), with int32 scratch and with
-    the int64 kept for meshes beyond it; a face flipped against its neighbours makes two
-    halfedges run the same way, which it reports."""
+    the int64 kept for meshes beyond it, serially and on threads; a face flipped against its
+    neighbours makes two halfedges run the same way, which both report."""
     V, F, _ = data
     F = np.ascontiguousarray(rng.permutation(len(V))[F])
     twin, err = K.twin_search(F, len(V))
@@ -49,12 +49,15 @@ def test_searched_twins_equal_a_dictionary_of_edges(data, rng):
     assert np.array_equal(twin, _twins_by_dictionary(F))
     wide = np.empty(3 * len(F), np.int64), np.empty(3 * len(F), np.int64), np.empty(3 * len(F), np.int64)
     assert K.halfedge_twins(F, len(V), *wide)[0] == K.OK and np.array_equal(wide[0], twin)  # beyond int32
+    for chunks in (2, 3, 7):  # on threads: groups filled in any order, the same twins
+        assert K.halfedge_twins_chunks(F, len(V), *wide, chunks)[0] == K.OK and np.array_equal(wide[0], twin)
     inner = np.flatnonzero((twin.reshape(-1, 3) >= 0).all(axis=1))
     if len(inner):
         flipped = F.copy()
         flipped[inner[0]] = flipped[inner[0], ::-1]
         if _twins_by_dictionary(flipped) is None:
             assert K.twin_search(flipped, len(V))[1] != K.OK
+            assert K.halfedge_twins_chunks(flipped, len(V), *wide, 3)[0] != K.OK
 
 
 @SETTINGS

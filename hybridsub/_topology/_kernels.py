@@ -20,6 +20,7 @@ import numba
 import numpy as np
 from numba import prange
 
+from .._atomic import atomic_add
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.refinement import (
@@ -123,24 +124,73 @@ def halfedge_twins(F, n_vertices, twin, key, half):
             half[k] = 3 * f + i
     twin[:] = -1
     for v in range(n_vertices):
-        a = start[v]
-        b = start[v + 1]
-        if b - a > _SORT_GROUP_FROM:
-            order = np.argsort(key[a:b], kind="mergesort")
-            key[a:b] = key[a:b][order]
-            half[a:b] = half[a:b][order]
-            for k in range(a, b - 1):
-                if key[k] >> 1 == key[k + 1] >> 1:
-                    err = _pair(twin, key[k], half[k], key[k + 1], half[k + 1])
-                    if err != OK:
-                        return err, half[k]
-            continue
-        for k in range(a, b):
-            for q in range(k + 1, b):
-                if key[q] >> 1 == key[k] >> 1:
-                    err = _pair(twin, key[k], half[k], key[q], half[q])
-                    if err != OK:
-                        return err, half[k]
+        err, bad = _match_group(start[v], start[v + 1], key, half, twin)
+        if err != OK:
+            return err, bad
+    return OK, -1
+
+
+@kernel(inline="always")
+def _match_group(a, b, key, half, twin):
+    """Pair the halfedges ``key[a:b]``, ``half[a:b]`` of one group into twins; returns
+    (OK, −1) or an error and its halfedge. A group longer than ``_SORT_GROUP_FROM`` is
+    sorted by key first, then only neighbours are compared."""
+    if b - a > _SORT_GROUP_FROM:
+        order = np.argsort(key[a:b], kind="mergesort")
+        key[a:b] = key[a:b][order]
+        half[a:b] = half[a:b][order]
+        for k in range(a, b - 1):
+            if key[k] >> 1 == key[k + 1] >> 1:
+                err = _pair(twin, key[k], half[k], key[k + 1], half[k + 1])
+                if err != OK:
+                    return err, np.int64(half[k])
+        return OK, np.int64(-1)
+    for k in range(a, b):
+        for q in range(k + 1, b):
+            if key[q] >> 1 == key[k] >> 1:
+                err = _pair(twin, key[k], half[k], key[q], half[q])
+                if err != OK:
+                    return err, np.int64(half[k])
+    return OK, np.int64(-1)
+
+
+@kernel(parallel=True)
+def halfedge_twins_chunks(F, n_vertices, twin, key, half, chunks):
+    """:func:`halfedge_twins` on ``chunks`` threads: chunks of faces count and place their
+    halfedges with atomic adds (so a group's order varies from run to run), then chunks of
+    vertices match their groups. The twins of a valid mesh are the same whatever that order
+    (each edge has one halfedge each way); on an invalid one some error is found, which
+    ``errors`` then names from the faces."""
+    m = F.shape[0]
+    start = np.zeros(n_vertices + 1, np.int64)
+    for c in prange(chunks):
+        for f in range(c * m // chunks, (c + 1) * m // chunks):
+            for i in range(3):
+                atomic_add(start, min(F[f, i], F[f, i + 1 if i < 2 else 0]) + 1, 1)
+    fill = _group_starts(start)
+    for c in prange(chunks):
+        for f in range(c * m // chunks, (c + 1) * m // chunks):
+            for i in range(3):
+                u = F[f, i]
+                w = F[f, i + 1 if i < 2 else 0]
+                k = atomic_add(fill, min(u, w), 1)
+                key[k] = 2 * max(u, w) + (1 if u < w else 0)
+                half[k] = 3 * f + i
+    errors = np.zeros(chunks, np.int64)
+    where = np.full(chunks, -1, np.int64)
+    for c in prange(chunks):
+        for t in range(3 * c * m // chunks, 3 * (c + 1) * m // chunks):
+            twin[t] = -1
+    for c in prange(chunks):
+        for v in range(c * n_vertices // chunks, (c + 1) * n_vertices // chunks):
+            err, bad = _match_group(start[v], start[v + 1], key, half, twin)
+            if err != OK:
+                errors[c] = err
+                where[c] = bad
+                break
+    for c in range(chunks):
+        if errors[c] != OK:
+            return errors[c], where[c]
     return OK, -1
 
 
@@ -152,7 +202,10 @@ def twin_search(F: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     key = np.empty(nh, np.int32 if small else np.int64)
     half = np.empty(nh, np.int32 if small else np.int64)
     twin = np.empty(nh, np.int64)
-    err, _ = halfedge_twins(F, n_vertices, twin, key, half)
+    if use_threads(F.shape[0]):
+        err, _ = halfedge_twins_chunks(F, n_vertices, twin, key, half, numba.get_num_threads())
+    else:
+        err, _ = halfedge_twins(F, n_vertices, twin, key, half)
     return twin, err
 
 
