@@ -17,7 +17,7 @@ from numba import prange
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
-from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_ends_in
+from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_edge, owned_ends_in
 from ._simd import lane, madd4, vzero
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
@@ -212,15 +212,6 @@ def _face_point_row(f, X, F, face_point, out):
 apply_step, apply_step_serial = threaded_and_serial(_apply_step)
 
 
-@kernel(inline="always")
-def _owned_edge(F, twin, f, i):
-    """(h, u, w): halfedge ``h = 3 f + i`` and its ends u → w if it owns its edge, else h = −1
-    (face and corner in: no division by 3)."""
-    h = 3 * f + i
-    t = twin[h]
-    return h if t < 0 or t > h else -1, F[f, i], F[f, i + 1 if i < 2 else 0]
-
-
 @kernel(parallel=NO_PARFORS)
 def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, indptr):
     """Fill ``indptr`` (n_new + 1, zeroed) with the CSR row offsets of the step's matrix."""
@@ -231,7 +222,7 @@ def matrix_row_sizes(F, twin, hsharp, has_tags, hkind, edge_point, face_point, c
         indptr[v + 1] = 1
     for f in range(m):
         for i in range(3):
-            h, u, w = _owned_edge(F, twin, f, i)
+            h, u, w = owned_edge(F, twin, f, i)
             if h < 0:
                 continue
             s = edge_sharpness(h, twin, hsharp, has_tags)
@@ -267,7 +258,7 @@ def fill_matrix(F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, 
         fill[v] += 1
     for f in range(m):
         for i in range(3):
-            h, u, w = _owned_edge(F, twin, f, i)
+            h, u, w = owned_edge(F, twin, f, i)
             if h < 0:
                 continue
             s = edge_sharpness(h, twin, hsharp, has_tags)

@@ -57,17 +57,22 @@ def edge_sharpness(h, twin, hsharp, has_tags):
 
 
 @kernel(inline="always")
-def owned_ends_in(F, twin, f, i, lo, hi):
-    """(u, w, u in lo:hi, w in lo:hi) for the edge u→w of halfedge ``3 f + i`` if it owns
-    it (the lower-numbered halfedge of the edge), else two Falses: a walk over every edge,
-    face by face, that keeps one range of vertices' terms, in the serial order, as the
-    threaded kernels do. Face and corner in, not the halfedge: no division by 3 per
-    halfedge (a fifth of such a walk's time)."""
+def owned_edge(F, twin, f, i):
+    """(h, u, w): halfedge ``h = 3 f + i`` and its ends u → w, h = −1 when it does not own
+    its edge (the lower-numbered halfedge of an edge owns it). Face and corner in: no
+    division by 3 (a fifth of a walk over every edge)."""
     h = 3 * f + i
     t = twin[h]
-    u = F[f, i]
-    w = F[f, i + 1 if i < 2 else 0]
-    if t >= 0 and t < h:
+    return h if t < 0 or t > h else -1, F[f, i], F[f, i + 1 if i < 2 else 0]
+
+
+@kernel(inline="always")
+def owned_ends_in(F, twin, f, i, lo, hi):
+    """(u, w, u in lo:hi, w in lo:hi) for the edge u→w of halfedge ``3 f + i`` if it owns
+    it (:func:`owned_edge`), else two Falses: a walk over every edge, face by face, that
+    keeps one range of vertices' terms, in the serial order, as the threaded kernels do."""
+    h, u, w = owned_edge(F, twin, f, i)
+    if h < 0:
         return u, w, False, False
     return u, w, lo <= u < hi, lo <= w < hi
 
