@@ -29,17 +29,17 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr_
     from ._input import Features, detect_features
     from ._io import TaggedMesh, load_example, read_mesh, write_mesh
     from ._jit import set_threads
-    from ._refiner import (FaceVaryingRefinement, FitResult, LimitSurface, MultiresDetails, Refinement,
-                           RefinementStep, fit, get_memory_limit, limit_matrix, limit_normals, limit_positions,
-                           refine, refine_face_varying, seam_edges, set_memory_limit, subdivide,
-                           subdivide_face_varying)
+    from ._fit import FitResult, MultiresDetails, fit
+    from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, refine,
+                           refine_face_varying, seam_edges, set_memory_limit, subdivide, subdivide_face_varying)
+    from ._surface import LimitSurface, limit_matrix, limit_normals, limit_positions
 
 #: Where each public name lives (imported when first used).
 _HOMES = {
-    "._refiner": ("FaceVaryingRefinement", "FitResult", "LimitSurface", "MultiresDetails", "Refinement",
-                  "RefinementStep", "fit", "get_memory_limit",
-                  "limit_matrix", "limit_normals", "limit_positions", "refine", "refine_face_varying", "seam_edges",
-                  "set_memory_limit", "subdivide", "subdivide_face_varying"),
+    "._refiner": ("FaceVaryingRefinement", "Refinement", "RefinementStep", "get_memory_limit", "refine",
+                  "refine_face_varying", "seam_edges", "set_memory_limit", "subdivide", "subdivide_face_varying"),
+    "._surface": ("LimitSurface", "limit_matrix", "limit_normals", "limit_positions"),
+    "._fit": ("FitResult", "MultiresDetails", "fit"),
     "._input": ("Features", "detect_features"),
     "._io": ("TaggedMesh", "load_example", "read_mesh", "write_mesh"),
     "._app.batch": ("BatchSummary", "batch"),
@@ -47,7 +47,7 @@ _HOMES = {
     "._jit": ("set_threads",),
 }
 _HOME_OF = {name: home for home, names in _HOMES.items() for name in names}
-_SUBMODULES = ("_app", "_io", "_refiner", "_input", "_topology", "_rules", "_jit", "_typing", "_units")
+_SUBMODULES = ("_app", "_io", "_refiner", "_surface", "_fit", "_input", "_topology", "_rules", "_jit", "_typing", "_units")
 
 __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",

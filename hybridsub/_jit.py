@@ -10,7 +10,7 @@ cache of unchanged sources loads as before.
 
 >>> import hybridsub
 >>> dependencies("hybridsub._topology._kernels")  # doctest: +NORMALIZE_WHITESPACE
-('hybridsub._atomic', 'hybridsub._jit', 'hybridsub._prefetch', 'hybridsub._rules.refinement',
+('hybridsub._atomic', 'hybridsub._jit', 'hybridsub._prefetch', 'hybridsub._rules.step_rules',
  'hybridsub._topology._halfedge_kernels', 'hybridsub._topology._kernels')
 """
 

@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse.csgraph as csgraph
 
-from ._rules import refinement as R
+from ._rules import step_rules as R
 from ._refiner import refine
 
 __all__ = [
@@ -343,7 +343,7 @@ def characteristic_map(n, scheme="loop", *, levels=4, crease=False, loop_weights
     >>> P.shape[1], F.shape[1], bool(np.isclose(lam[0], (3 + 2 * np.cos(2 * np.pi / 5)) / 8))
     (2, 3, True)
     """
-    from ._refiner import limit_positions
+    from ._surface import limit_positions
 
     n = _check_n(n, crease)
     _check_scheme(scheme)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from hybridsub._rules import refinement as R
+from hybridsub._rules import step_rules as R
 from hybridsub import analysis
 from hybridsub._topology.level import build_level
 

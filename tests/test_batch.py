@@ -27,7 +27,7 @@ from conftest import DATA
 from hybridsub._app import batch as _batch
 from hybridsub._app import task as _task
 from hybridsub._app.manifest import LEGACY_MANIFEST, LOCKFILE, MANIFEST, TMPDIR, LockError, Manifest
-from hybridsub._app.plan import Planner, walk_inputs
+from hybridsub._app.batch_plan import Planner, walk_inputs
 from hybridsub._app.cli import main
 from hybridsub._app.progress import BatchProgress
 from strategies import grid, sphere_hull, torus

@@ -135,7 +135,7 @@ def test_subdivide_peak_is_at_most_twice_its_output(scheme):
 
 
 def test_more_vertices_than_int32_holds_are_refused(monkeypatch):
-    from hybridsub._topology import plan as _plan
+    from hybridsub._topology import step_plan as _plan
 
     V, F = ms.octahedron()
     monkeypatch.setattr(_plan, "INDEX_LIMIT", 200)  # as if a level could pass 2**31 vertices

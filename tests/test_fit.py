@@ -5,8 +5,8 @@ import pytest
 
 import hybridsub
 from conftest import load_mesh
-from hybridsub._refiner._closest_kernels import closest_among
-from hybridsub._refiner.closest import ClosestPoints, closest_points
+from hybridsub._fit._closest_kernels import closest_among
+from hybridsub._fit.closest import ClosestPoints, closest_points
 
 
 def _control():
@@ -73,7 +73,7 @@ def test_smoothness_trades_distance_for_fairness_and_keeps_corners():
     corner = [int(CREASES[0, 0])]
     plain = hybridsub.fit(FC, pts, CREASES, corners=corner, V0=VC, levels=1, max_iterations=3)
     fair = hybridsub.fit(FC, pts, CREASES, corners=corner, V0=VC, levels=1, smoothness=1.0, max_iterations=3)
-    lap = hybridsub._refiner.fitting.umbrella(FC, len(VC), CREASES, np.isin(np.arange(len(VC)), corner))
+    lap = hybridsub._fit.fitting.umbrella(FC, len(VC), CREASES, np.isin(np.arange(len(VC)), corner))
     assert np.abs(lap[corner[0]].toarray()).max() == 0              # corners are not smoothed
     assert np.count_nonzero(lap[int(CREASES[1, 0])].toarray()) == 3  # a crease vertex: its two crease neighbours
     assert fair.rms > plain.rms
@@ -160,7 +160,7 @@ def test_closest_points_of_far_points_are_exact():
 
 
 def test_an_update_that_raises_the_error_is_halved_back(monkeypatch):
-    import hybridsub._refiner.fitting as fitting
+    import hybridsub._fit.fitting as fitting
 
     rng = np.random.default_rng(11)
     r = hybridsub.refine(FC, CREASES, levels=2)

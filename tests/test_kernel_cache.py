@@ -65,7 +65,7 @@ def test_every_cached_kernel_is_keyed_on_the_modules_it_compiles_in():
 
 
 def test_kernels_depend_on_the_rules_they_compile_in():
-    rules = "hybridsub._rules.refinement"
+    rules = "hybridsub._rules.step_rules"
     halfedges = "hybridsub._topology._halfedge_kernels"
     assert {rules, halfedges} <= set(dependencies("hybridsub._topology._kernels"))
     assert {rules, halfedges} <= set(dependencies("hybridsub._refiner._stencil_kernels"))

@@ -16,7 +16,7 @@ from conftest import load_mesh
 import hybridsub
 from hybridsub import MeshError, analysis
 from hybridsub._rules import limit as LR
-from hybridsub._rules import refinement as R
+from hybridsub._rules import step_rules as R
 from hybridsub.analysis import _canonical_order, model_neighbourhood
 
 
@@ -292,8 +292,8 @@ def test_loop_crease_sector_normals_converge():
     V, F = load_mesh("mesh_with_border")
     Nc = hybridsub.limit_normals(V, F, scheme="loop", per_face_corner=True)
     n = len(V)
-    from hybridsub._refiner.limit.api import setup_limit
-    from hybridsub._refiner.limit.plan import plan_level
+    from hybridsub._surface.vertex_limit import setup_limit
+    from hybridsub._surface.mask_plan import plan_level
     s = setup_limit(F, None, 0, n, "loop", None, None, None, "loop")
     pl = plan_level(s.level, s.esharp, s.face_sharp, s.corner, "loop", "loop")
     k = pl.sectors.n_faces
@@ -317,7 +317,7 @@ def test_loop_crease_sector_normals_converge():
 
 
 def _evolve_sector_estimate(V, F, center, crease, levels):
-    """Independent of hybridsub._refiner.limit: refine the star of a crease vertex again and again with
+    """Independent of hybridsub._surface: refine the star of a crease vertex again and again with
     hybridsub.refine and return (Σ e_j) × (Σ j e_j) of the sector starting at crease[0]."""
     P, Fl, c, a = V.copy(), F.copy(), center, crease[0]
     se = np.array([[center, crease[0]], [center, crease[1]]])
@@ -413,7 +413,7 @@ def test_bad_input():
 def test_dart_mixed_and_fin_normals():
     # Darts and mixed vertices of the hybrid scheme: the control fan's normal after FAN_LEVELS
     # local levels (no tangent plane there); stable, unit, on the side the faces face.
-    from hybridsub._refiner.limit.local import FAN_LEVELS
+    from hybridsub._surface.local import FAN_LEVELS
     V, F = _sphere(1)
     e = np.array([F[0, :2]])
     for kw in ({"sharp_edges": e}, {"sharp_faces": np.arange(0, len(F), 3)}):

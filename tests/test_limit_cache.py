@@ -7,8 +7,31 @@ import scipy.sparse as sp
 from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
 
 import hybridsub
-from hybridsub._refiner.limit.descent import direct_rows
-from hybridsub._refiner.limit.regular import is_regular, regular_torus
+from hybridsub._surface import descent as D
+from hybridsub._surface.regular import is_regular, regular_torus
+
+
+def direct_rows(inp, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, tol: float,
+                max_levels: int):
+    """The rows of ``walk.walk_rows`` by the direct descent, every patch refined where it
+    is met (no cache): the reference the cached walk is tested against."""
+    faces0, qn = np.unique(f, return_inverse=True)
+    p, sel0, _ = D.start(inp, faces0)
+    maps = [sel0]
+    qn, bb = qn.ravel(), b
+    for k in range(depth):
+        p, A, qn, bb = D.step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
+        maps.append(A)
+    ids, *weights = D.stencil(p, qn, bb)
+    L = D.limit_rows(p, np.unique(ids), inp.scheme, inp.loop_weights, tol, max_levels)
+    q = len(f)
+    W = np.concatenate([w.ravel() for w in weights[:n_rows]])
+    R = sp.csr_matrix((W, np.tile(ids.ravel(), n_rows), np.arange(0, 6 * n_rows * q + 1, 6)),
+                      shape=(n_rows * q, p.level.n_vertices)) @ L
+    for A in reversed(maps):  # all rows (value, derivatives) through the levels at once
+        R = R @ A
+    R = sp.csr_matrix(R)
+    return [R[i * q:(i + 1) * q] for i in range(n_rows)]
 
 
 def _direct(s, f, b, n_rows):
@@ -238,7 +261,7 @@ def _one_rings(F, faces):
 def test_quartic_kernel_matches_its_definition():
     """quartic_points (the walk's kernel) == the Bernstein basis of regular.bernstein, chained
     to (u, v) by hand."""
-    from hybridsub._refiner.limit.regular import bernstein, polynomial_weights
+    from hybridsub._surface.regular import bernstein, polynomial_weights
 
     rng = np.random.default_rng(8)
     bary = rng.dirichlet([1, 1, 1], 20)
@@ -277,7 +300,7 @@ def test_evaluate_in_chunks_equals_the_matrix_bit_for_bit(mesh, monkeypatch):
     rings) == evaluation_matrix @ V to the bit, in chunks with the cache emptied between
     them, for 3-column, 1-D and empty data; the matrices hold no explicit zeros. Derivatives
     (applied to the data forward, where the rows cancel) agree to rounding."""
-    import hybridsub._refiner.limit.surface as surface
+    import hybridsub._surface.surface as surface
 
     (V, F), kw = _regular_meshes(mesh)
     face, bary = _points(F, 50, seed=12)

@@ -8,7 +8,7 @@ import pytest
 import hybridsub
 from hybridsub._input import open_gate
 from hybridsub._refiner.chart import EQUILATERAL, child_shapes, glue, plan_supports
-from hybridsub._refiner.limit import descent as D
+from hybridsub._surface import descent as D
 from hybridsub._topology import child_level, face_parents, plan_step
 
 FAN_V = np.array([[0.0, 0, 0.3]] + [[np.cos(a), np.sin(a), 0.1 * np.sin(3 * a)]

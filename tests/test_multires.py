@@ -5,7 +5,7 @@ import pytest
 
 import hybridsub
 from conftest import load_mesh
-from hybridsub._refiner.multires import local_frames
+from hybridsub._fit.multires import local_frames
 
 
 def _cases():

@@ -145,7 +145,7 @@ def test_threaded_kernels_equal_serial_bit_for_bit(data, scheme, levels):
 def test_classification_in_chunks_equals_the_serial_pass(data, scheme, odd, chunks, seed):
     """classify_step_chunks (big meshes, on threads) numbers points, kinds and per-vertex
     counts exactly as classify_step does, for any number of chunks, with forced splits too."""
-    from hybridsub._rules import refinement as R
+    from hybridsub._rules import step_rules as R
 
     V, F, tags = data
     if scheme == "sqrt3":
@@ -182,7 +182,7 @@ def test_classification_in_chunks_sums_fractional_sharpness_in_the_serial_order(
     the threaded pass gathers by vertex ranges in edge order: fandisk's creases, each with
     its own sharpness in (0, 1], give the serial pass's counts and sums to the bit."""
     import hybridsub
-    from hybridsub._rules import refinement as R
+    from hybridsub._rules import step_rules as R
 
     V, F = hybridsub.load_example()
     pairs = hybridsub.detect_features(V, F, 30).sharp_edges
@@ -209,7 +209,7 @@ def test_step_counts_equal_counting_the_masks(data, scheme, levels):
     """The budget's counts of a step, in one pass, equal the counts of its masks: boundary
     halfedges, split and trisected edges (an interior edge once), split halfedges of smooth
     faces, sharp faces and face points."""
-    from hybridsub._rules import refinement as R
+    from hybridsub._rules import step_rules as R
 
     V, F, tags = data
     if scheme == "sqrt3":

@@ -203,7 +203,7 @@ def fig_limit(out, quick):
 
     # Convergence: |S_L V − L V| over the input vertices, against the predicted rates.
     fig, ax = plt.subplots(figsize=(6.2, 4.2))
-    cases = [("icosahedron", "sqrt3", {}, 2 / 3 - float(hybridsub._rules.refinement.kobbelt_alpha(5))),
+    cases = [("icosahedron", "sqrt3", {}, 2 / 3 - float(hybridsub._rules.step_rules.kobbelt_alpha(5))),
              ("icosahedron", "loop", {}, ((3 + 2 * np.cos(2 * np.pi / 5)) / 8) ** 2),
              ("cube-meshed", "hybrid", "features", None), ("cube-meshed", "loop", "features", None)]
     data = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data")
@@ -243,7 +243,7 @@ def fig_spectra(out, quick):
             ax.plot(ns, [e[j] if j < len(e) else np.nan for e in ev], "o", ms=3, label=f"|λ{j + 1}|")
         cf = [analysis.closed_form_spectrum(int(n), scheme) for n in ns]
         if scheme == "sqrt3":
-            a = hybridsub._rules.refinement.kobbelt_alpha(ns)
+            a = hybridsub._rules.step_rules.kobbelt_alpha(ns)
             ax.plot(ns, (2 + 2 * np.cos(2 * np.pi / ns)) / 9, "k-", lw=0.8, label="eq. (7): (2+2cos 2π/n)/9")
             ax.plot(ns, (2 - 3 * a) ** 2 / 9, "k--", lw=0.8, label="eq. (7): (2−3α_n)²/9")
             ax.set_title("√3, two steps (aligned ring)", fontsize=10)

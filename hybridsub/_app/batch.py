@@ -37,7 +37,7 @@ from .manifest import (
     Manifest,
     is_disk_full,
 )
-from .plan import CHUNK, Chunk, Planner, clean_tmpdir, walk_inputs
+from .batch_plan import CHUNK, Chunk, Planner, clean_tmpdir, walk_inputs
 from .task import run_task
 
 __all__ = ["BatchSummary", "batch"]

@@ -469,18 +469,18 @@ def _add_demo(sub) -> None:
 
 
 # ----------------------------------------------------------------------------------------------
-# fit and decompose (issue 15): the work is in _app/fitting.py
+# fit and decompose (issue 15): the work is in _app/fit_command.py
 
 
 def cmd_fit(a) -> int:
-    from .fitting import fit_file
+    from .fit_command import fit_file
 
     return fit_file(a.control, a.target, a.output, levels=a.levels, scheme=a.scheme, smoothness=a.smoothness,
                     max_iterations=a.max_iterations, tol=a.tol, quiet=a.quiet)
 
 
 def cmd_decompose(a) -> int:
-    from .fitting import decompose_file
+    from .fit_command import decompose_file
 
     return decompose_file(a.coarse, a.fine, a.output, levels=a.levels, scheme=a.scheme, quiet=a.quiet)
 

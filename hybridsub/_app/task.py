@@ -14,7 +14,7 @@ from .._errors import MeshError
 from .._version import __version__
 from .manifest import is_disk_full
 from .pipeline import FileOptions, PipelineError, subdivide_file
-from .plan import PENDING
+from .batch_plan import PENDING
 
 _CHUNK = 1 << 20
 

@@ -11,7 +11,7 @@ import operator
 
 import numpy as np
 
-from .._rules import refinement as R
+from .._rules import step_rules as R
 from .._errors import MeshError
 from .._typing import SCHEMES
 

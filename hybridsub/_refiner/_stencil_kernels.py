@@ -16,7 +16,7 @@ from numba import prange
 
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
-from .._rules.refinement import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
+from .._rules.step_rules import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
 from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_edge, owned_ends_in
 from ._simd import lane, madd4, vzero
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._rules import refinement as R
+from .._rules import step_rules as R
 from . import stencils as _stencils
 from ._stencil_kernels import product_bound
 from .._errors import OutputTooLargeError

@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._input.gate import RefineInput
-from .._rules import refinement as R
+from .._rules import step_rules as R
 from .._topology import Level, StepPlan, child_level, plan_step
 from .bar import level_bar, tick
 from .budget import Budget

@@ -15,13 +15,17 @@ import scipy.sparse as sp
 
 from .._input import RefineInput, as_data, count_of, open_gate, tag_counts, writable
 from .._topology import build_level, child_creases, face_parents
+from typing import TYPE_CHECKING
+
 from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .budget import Budget, check_product
 from .chart import vertex_origins
 from .loop import Step, walk
 from .linear_uv import linear_uv_matrix
-from .multires import MultiresDetails, decompose, reconstruct
 from .stencils import CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order, product, step_matrix
+
+if TYPE_CHECKING:
+    from .._fit.multires import MultiresDetails
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,7 +240,7 @@ class Refinement:
             self._cache[key] = [coded_stencils(S) or S for S in in_read_order(mats)]
         return self._cache[key]
 
-    def decompose(self, X: ArrayLike, *, frames: bool | None = None) -> tuple[np.ndarray, MultiresDetails]:
+    def decompose(self, X: ArrayLike, *, frames: bool | None = None) -> tuple[np.ndarray, "MultiresDetails"]:
         """Reverse subdivision: coarse data and per-level details of finest-level data ``X``.
 
         Level by level from the finest, the coarser data is the least-squares fit
@@ -271,9 +275,10 @@ class Refinement:
         >>> bool(np.allclose(coarse, V)), bool(details.norms().max() < 1e-12)
         (True, True)
         """
+        from .._fit.multires import decompose  # the one call up a layer: see docs/architecture.md
         return decompose(self.steps, self.n_coarse, self._cache, X, frames)
 
-    def reconstruct(self, coarse: ArrayLike, details: MultiresDetails) -> np.ndarray:
+    def reconstruct(self, coarse: ArrayLike, details: "MultiresDetails") -> np.ndarray:
         """Finest-level data from coarse data and :meth:`decompose`'s details.
 
         ``reconstruct(*decompose(X)) == X`` to rounding. With details in local frames, edited
@@ -290,6 +295,7 @@ class Refinement:
         >>> bool(np.abs(r.reconstruct(coarse, details) - X).max() < 1e-12)
         True
         """
+        from .._fit.multires import reconstruct
         return reconstruct(self.steps, self.n_coarse, coarse, details)
 
 

@@ -17,7 +17,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import refinement as R
+from . import step_rules as R
 
 #: Limit mask of a crease vertex (self, each crease neighbour): the cubic B-spline at a knot.
 CREASE_LIMIT_MASK = (2.0 / 3.0, 1.0 / 6.0)

@@ -11,7 +11,7 @@ from .edges import (EdgeGroups, UndirectedEdges, edge_keys, group_halfedges, hal
 from .emit import child_creases, child_level, face_parents
 from .errors import duplicate_faces_error, not_an_edge_error, topology_error
 from .level import Level, build_level, checked_level
-from .plan import StepPlan, plan_step, step_arguments
+from .step_plan import StepPlan, plan_step, step_arguments
 from .sectors import Sectors, vertex_sectors
 from .uv import linear_rows, seam_halfedges, uv_start
 

@@ -23,7 +23,7 @@ from numba import prange
 from .._atomic import atomic_add
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
-from .._rules.refinement import (
+from .._rules.step_rules import (
     EDGE_FLIP,
     EDGE_KEEP,
     EDGE_SPLIT,

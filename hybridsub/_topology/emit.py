@@ -4,7 +4,7 @@ vertex pairs).
 
 >>> import numpy as np
 >>> from hybridsub._topology.level import checked_level
->>> from hybridsub._topology.plan import plan_step
+>>> from hybridsub._topology.step_plan import plan_step
 >>> level = checked_level(np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]), 4)
 >>> faces, child, offsets = child_level(level, plan_step(level, np.zeros(4, bool), "sqrt3", 1, "loop"))
 >>> faces.shape, child.n_vertices, face_parents(offsets)[:4].tolist()
@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._rules import refinement as R
+from .._rules import step_rules as R
 from . import _kernels as K
 from .level import Level
-from .plan import EMPTY_FLOAT, StepPlan
+from .step_plan import EMPTY_FLOAT, StepPlan
 
 
 def child_level(level: Level, plan: StepPlan, want_topology: bool = True):

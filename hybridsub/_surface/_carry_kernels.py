@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..._jit import NO_PARFORS, kernel, threaded_and_serial
+from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from ._walk_kernels import TASK
 
 _U0, _U1 = np.uintp(0), np.uintp(1)

@@ -31,8 +31,8 @@ from .._input import as_vertices
 from .._typing import ArrayLike, LoopWeights, Scheme
 from ._closest_kernels import face_systems
 from .closest import ClosestPoints
-from .limit import LimitSurface
-from .refinement import refine
+from .._surface import LimitSurface
+from .._refiner import refine
 
 TANGENT_WEIGHT = 1e-6       # λ near the target: the tangential damping
 TANGENT_WEIGHT_MAX = 1e-2   # λ far from it (λ = RMS / diagonal in between)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import as_vertices, open_gate, writable
-from ..._typing import ArrayLike, LoopWeights, Scheme
+from .._input import as_vertices, open_gate, writable
+from .._typing import ArrayLike, LoopWeights, Scheme
 from .cache import PatchTable
 from .depth import PointDepths
 from .project import closest_points, seed_setup
@@ -124,7 +124,7 @@ class LimitSurface:
         return f, b / total[:, None]
 
     def _new_cache(self):
-        """An empty patch cache (``_refiner/limit/cache.py``): filled as points are evaluated."""
+        """An empty patch cache (``_surface/cache.py``): filled as points are evaluated."""
         self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels)
         self._starts = StartKeys(self._inp, self._table)
 

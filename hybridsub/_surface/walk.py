@@ -19,8 +19,8 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import RefineInput, open_gate
-from ..._topology import use_threads
+from .._input import RefineInput, open_gate
+from .._topology import use_threads
 from ._carry_kernels import (
     back_points,
     back_points_serial,

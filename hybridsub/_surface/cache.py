@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._topology import Level
-from ..chart import barycentric
+from .._topology import Level
+from .._refiner import barycentric
 from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
 from .descent import (
     Patches,

@@ -10,13 +10,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import as_vertices, open_gate
-from ..._topology import Level, build_level
-from ..._typing import ArrayLike, LoopWeights, Scheme
-from ..refinement import refinement_of
+from .._input import as_vertices, open_gate
+from .._topology import Level, build_level
+from .._typing import ArrayLike, LoopWeights, Scheme
+from .._refiner import refinement_of
 from .local import refine_locally
 from .normals import sector_normals, unit
-from .plan import SEC_TRANSIENT, edge_sharpness, plan_level
+from .mask_plan import SEC_TRANSIENT, edge_sharpness, plan_level
 
 # ---------------------------------------------------------------------------------------------
 # Input preparation: the mesh refined to the level evaluated, its tags per edge, face, vertex

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .._rules import refinement as R
+from .._rules import step_rules as R
 from . import _classify_kernels as C
 from . import _kernels as K
 from .level import Level

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._topology import Level, build_level, halfedge_ends
-from ..refinement import refine
+from .._topology import Level, build_level, halfedge_ends
+from .._refiner import refine
 from .normals import run_estimate, sector_normals
-from .plan import SEC_TRANSIENT, LimitPlan, edge_sharpness, plan_level
+from .mask_plan import SEC_TRANSIENT, LimitPlan, edge_sharpness, plan_level
 
 #: Local levels after which the fan normal of a dart or mixed vertex of the hybrid scheme is
 #: taken (it has no tangent plane; the fan's normal moves by O(1/levels) per level).

@@ -1,15 +1,16 @@
-"""The limit surface: where the refined meshes converge to, and its normals.
+"""The limit surface (OpenSubdiv's Bfr), above the refiner: where the refined meshes converge
+to, its normals, and the surface at any point.
 
-``plan`` decides which stationary mask (``_rules.limit``) applies at every vertex and sector
+``mask_plan`` decides which stationary mask (``_rules.limit``) applies at every vertex and sector
 of a level, on the sectors the topology layer cuts (``_topology.vertex_sectors``);
 ``normals`` turns tangent masks and control fans into sector normals; ``local`` refines the
-stars of the vertices without a stationary mask until their rows and normals settle; ``api``
+stars of the vertices without a stationary mask until their rows and normals settle; ``vertex_limit``
 holds the public functions. ``descent`` follows any point of the surface down the refinement
 (exact local refinement), ``surface`` is :class:`LimitSurface` on top of it, ``project`` its
 closest points. ``docs/limit.md`` explains every decision taken here.
 """
 
-from .api import limit_matrix, limit_normals, limit_positions
+from .vertex_limit import limit_matrix, limit_normals, limit_positions
 from .surface import LimitSurface
 
 __all__ = ["LimitSurface", "limit_matrix", "limit_normals", "limit_positions"]

@@ -16,7 +16,8 @@ import sys
 import numpy as np
 
 from .. import _io
-from .._refiner import fit, refine
+from .._fit import fit
+from .._refiner import refine
 
 POINT_FILES = (".xyz", ".txt", ".csv", ".npy")
 

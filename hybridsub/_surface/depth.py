@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._input import RefineInput
+from .._input import RefineInput
 from ._walk_kernels import AT_VERTEX
 
 #: Levels past the one where the faces' size equals the distance (see the module docstring).

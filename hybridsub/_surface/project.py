@@ -7,12 +7,11 @@ import dataclasses
 
 import numpy as np
 
-from ..._input import RefineInput
-from ..._topology import build_level
-from ..chart import onto_input_faces
-from ..refinement import refinement_of
-from .api import LimitSetup, _evaluate
-from .plan import edge_sharpness
+from .._input import RefineInput
+from .._topology import build_level
+from .._refiner import onto_input_faces, refinement_of
+from .vertex_limit import LimitSetup, _evaluate
+from .mask_plan import edge_sharpness
 
 #: Levels of the refined mesh whose limit points seed the search.
 SEED_LEVELS = 2

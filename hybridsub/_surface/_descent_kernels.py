@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._jit import kernel
-from ..._topology import group_by_origin
+from .._jit import kernel
+from .._topology import group_by_origin
 
 
 @kernel(inline="always")

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..._jit import kernel, threaded_and_serial
+from .._jit import kernel, threaded_and_serial
 
 #: Candidates whose smallest barycentric coordinates differ by less are a tie.
 TIE = 1e-14

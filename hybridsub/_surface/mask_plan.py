@@ -14,9 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._rules import limit as LR
-from ..._rules import refinement as R
-from ..._topology import Level, Sectors, not_an_edge_error, vertex_sectors
+from .._rules import limit as LR
+from .._rules import step_rules as R
+from .._topology import Level, Sectors, not_an_edge_error, vertex_sectors
 
 # How a sector's normal is found.
 SEC_SMOOTH = 0  # cos/sin tangent masks (Kobbelt and Loop smooth vertices)

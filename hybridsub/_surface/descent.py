@@ -22,13 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..._input import RefineInput
-from ..._topology import Level, child_level, face_parents, plan_step
-from ..chart import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports
-from ..stencils import step_matrix
+from .._input import RefineInput
+from .._topology import Level, child_level, face_parents, plan_step
+from .._refiner import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports, step_matrix
 from ._descent_kernels import cut_pieces, ring_pairs
 from .local import refine_locally
-from .plan import plan_level
+from .mask_plan import plan_level
 
 #: Vertex rings of faces around a point's face kept at every level.
 RINGS = 2
@@ -250,26 +249,3 @@ def stencil_weights(A, full, c0, scale, here, uv, bary):
     H = np.stack([np.stack([W[:, :, 3], W[:, :, 4]], -1), np.stack([W[:, :, 4], W[:, :, 5]], -1)], -1)
     Huv = np.einsum("qai,qkab,qbj->qkij", J, H, J)
     return W[:, :, 0], Wu, Wv, Huv[:, :, 0, 0], Huv[:, :, 0, 1], Huv[:, :, 1, 1]
-
-
-def direct_rows(inp: RefineInput, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, tol: float,
-                max_levels: int):
-    """The rows of :func:`.walk.walk_rows` by the direct descent, every patch refined where it
-    is met (no cache): the reference the cached walk is tested against."""
-    faces0, qn = np.unique(f, return_inverse=True)
-    p, sel0, _ = start(inp, faces0)
-    maps = [sel0]
-    qn, bb = qn.ravel(), b
-    for k in range(depth):
-        p, A, qn, bb = step(p, qn, bb, inp.scheme, inp.loop_weights, k + 1)
-        maps.append(A)
-    ids, *weights = stencil(p, qn, bb)
-    L = limit_rows(p, np.unique(ids), inp.scheme, inp.loop_weights, tol, max_levels)
-    q = len(f)
-    W = np.concatenate([w.ravel() for w in weights[:n_rows]])
-    R = sp.csr_matrix((W, np.tile(ids.ravel(), n_rows), np.arange(0, 6 * n_rows * q + 1, 6)),
-                      shape=(n_rows * q, p.level.n_vertices)) @ L
-    for A in reversed(maps):  # all rows (value, derivatives) through the levels at once
-        R = R @ A
-    R = sp.csr_matrix(R)
-    return [R[i * q:(i + 1) * q] for i in range(n_rows)]

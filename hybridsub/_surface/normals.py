@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._topology import Level, Sectors, next_halfedge, prev_halfedge
-from .plan import SEC_CORNER, SEC_FAN, SEC_TRANSIENT, LimitPlan
+from .._topology import Level, Sectors, next_halfedge, prev_halfedge
+from .mask_plan import SEC_CORNER, SEC_FAN, SEC_TRANSIENT, LimitPlan
 
 
 def unit(A: np.ndarray) -> np.ndarray:
