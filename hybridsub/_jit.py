@@ -28,10 +28,17 @@ import warnings
 import numba
 import numpy as np
 from numba import njit
-from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
-from numba.core.cpu_options import ParallelOptions
-from numba.core.dispatcher import Dispatcher
 from numba.core.errors import NumbaPerformanceWarning
+
+try:  # Numba's private cache classes: where they move, kernels fall back to plain cache=True
+    from numba.core.caching import CompileResultCacheImpl, FunctionCache, NullCache, _CacheLocator
+    from numba.core.dispatcher import Dispatcher
+except ImportError:  # pragma: no cover - depends on the installed Numba
+    _CacheLocator = None
+try:
+    from numba.core.cpu_options import ParallelOptions
+except ImportError:  # pragma: no cover - depends on the installed Numba
+    ParallelOptions = None
 
 # ``from X import a, b`` (parenthesised over lines or not) and ``import X``, at a line's start.
 _FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)", re.M)
@@ -53,30 +60,134 @@ def kernel(fn=None, **options):
     """
     if fn is None:
         return functools.partial(kernel, **options)
-    dispatcher = njit(**options)(fn)
-    if not isinstance(dispatcher, Dispatcher):  # NUMBA_DISABLE_JIT: the plain function
-        return dispatcher
-    if not isinstance(getattr(dispatcher, "_cache", None), NullCache):  # Numba's internals moved
-        raise RuntimeError("numba's dispatcher keeps its cache elsewhere: update hybridsub._jit")
-    dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # what Dispatcher.enable_caching does
-    if options.get("parallel") is NO_PARFORS:
+    if "parallel" in options and options["parallel"] is NO_PARFORS:
+        options["parallel"] = serial_pipeline()
+    quiet = NO_PARFORS is not None and options.get("parallel") is NO_PARFORS
+    if not _keyed_cache_works():
+        dispatcher = njit(cache=True, **options)(fn)
+    else:
+        dispatcher = njit(**options)(fn)
+        if _CacheLocator is not None and isinstance(dispatcher, Dispatcher):  # not NUMBA_DISABLE_JIT
+            dispatcher._cache = DependencyKeyedCache(dispatcher.py_func)  # as Dispatcher.enable_caching
+    if quiet and hasattr(dispatcher, "compile"):
         dispatcher.compile = _quietly(dispatcher.compile)
     return dispatcher
+
+
+@functools.lru_cache(maxsize=None)
+def _keyed_cache_works() -> bool:
+    """Whether Numba's private cache classes are where :class:`DependencyKeyedCache` expects
+    them (checked on a throwaway dispatcher, once). Where not, every kernel is plain
+    ``njit(cache=True)`` and a warning says that an edit to a rule module then needs
+    ``__pycache__`` (or ``NUMBA_CACHE_DIR``) cleared: never an import failure."""
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
+        return True
+    works = _CacheLocator is not None
+    if works:
+        try:
+            probe = njit(lambda: 0)
+            works = isinstance(probe, Dispatcher) and isinstance(getattr(probe, "_cache", None), NullCache)
+            DependencyKeyedCache(_probe_function)._impl.locator.get_source_stamp()
+        except Exception:  # noqa: BLE001 - any change in Numba's internals
+            works = False
+    if not works:
+        warnings.warn(f"hybridsub: numba {numba.__version__} keeps its kernel cache differently from the "
+                      "versions hybridsub was tested with; kernels use plain cache=True, so after editing "
+                      "hybridsub's sources clear the Numba cache (__pycache__ or NUMBA_CACHE_DIR)",
+                      RuntimeWarning, stacklevel=3)
+    return works
+
+
+def _probe_function():
+    return 0
+
+
+class _CompileNotice(numba.core.event.Listener):
+    """Says once per process, on stderr, that hybridsub's kernels are being compiled: the
+    first call after an install (or after an edit of the sources) waits for it, and a
+    silent wait of many seconds reads as a hang. ``HYBRIDSUB_COMPILE_NOTICE=0`` silences it."""
+
+    said = False
+
+    def on_start(self, event):
+        if _CompileNotice.said:
+            return
+        dispatcher = event.data.get("dispatcher")
+        module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+        if not module.startswith("hybridsub."):
+            return
+        _CompileNotice.said = True
+        if os.environ.get("HYBRIDSUB_COMPILE_NOTICE", "1") == "0":
+            return
+        _say(f"hybridsub: compiling its kernels for this machine, once (seconds for a first call; each "
+             f"new kind of call compiles what it needs). Later runs load them from {_cache_home(dispatcher)} "
+             f"(NUMBA_CACHE_DIR moves it); `hybridsub warmup` compiles all of them ahead.")
+
+    def on_end(self, event):
+        pass
+
+
+def _cache_home(dispatcher) -> str:
+    """Where the compiled kernels go, in words."""
+    if numba.config.CACHE_DIR:
+        return numba.config.CACHE_DIR
+    path = getattr(getattr(dispatcher, "_cache", None), "_cache_path", None)
+    if not path:
+        return "Numba's cache"
+    if os.path.basename(path) == "__pycache__":
+        return f"the __pycache__ folders in {os.path.dirname(os.path.dirname(path))}"
+    return path
+
+
+def _say(message: str) -> None:
+    """``message`` on stderr, above a tqdm bar if one is drawn."""
+    tqdm = sys.modules.get("tqdm")
+    if tqdm is not None and getattr(tqdm, "tqdm", None) is not None:
+        tqdm.tqdm.write(message, file=sys.stderr)
+    else:
+        print(message, file=sys.stderr, flush=True)
+
+
+numba.core.event.register("numba:compile", _CompileNotice())
 
 
 #: ``kernel(parallel=NO_PARFORS)``: Numba's parallel pipeline with every transformation off.
 #: ``prange`` runs as ``range`` and nothing runs on threads, but the code is the parallel
 #: pipeline's, which keeps arrays out of reference counting inside loops where Numba's plain
-#: pipeline counts references of array views on every iteration (armadillo's last Loop step
-#: on one thread: its classification in one pass 44 → 12 ms, its data 205 → 39 ms). The
-#: same operations, so the same bits. Used by the serial twins of
+#: pipeline counts references of array views on every iteration (docs/performance.md,
+#: "Kernel design"). The same operations, so the same bits. Used by the serial twins of
 #: :func:`threaded_and_serial` (a step's kernels on one thread, the limit surface's walk),
 #: a step's one-pass kernels and the limit surface's per-point kernels, whose outputs the
 #: tests check bit for bit.
 #: (An options object, not a dict: Numba empties a dict of parallel options as it reads it,
 #: so a shared dict would leave every later kernel fully parallel.)
-NO_PARFORS = ParallelOptions({"prange": False, "numpy": False, "reduction": False, "setitem": False,
-                              "stencil": False, "comprehension": False, "fusion": False, "inplace_binop": False})
+NO_PARFORS = None if ParallelOptions is None else ParallelOptions({
+    "prange": False, "numpy": False, "reduction": False, "setitem": False, "stencil": False,
+    "comprehension": False, "fusion": False, "inplace_binop": False})
+
+
+#: The Numba releases on which :data:`NO_PARFORS` was checked to do what it says (``prange``
+#: in order on the calling thread, no thread launched, the warning :func:`_quietly` drops):
+#: ``tests/test_kernel_cache.py`` fails if a release changes any of it. Outside this range,
+#: and with ``HYBRIDSUB_NO_PARFORS=0``, the serial kernels use Numba's plain pipeline
+#: instead: the same results, slower loops.
+NO_PARFORS_VERIFIED = ((0, 60), (0, 68))
+
+
+def serial_pipeline():
+    """What ``parallel=`` a serial kernel gets: :data:`NO_PARFORS` where it was verified
+    (:data:`NO_PARFORS_VERIFIED`), else False.
+
+    Examples
+    --------
+    >>> serial_pipeline() in (NO_PARFORS, False)
+    True
+    """
+    if os.environ.get("HYBRIDSUB_NO_PARFORS", "1") == "0":
+        return False
+    version = tuple(int(part) for part in re.findall(r"\d+", numba.__version__)[:2])
+    low, high = NO_PARFORS_VERIFIED
+    return NO_PARFORS if NO_PARFORS is not None and low <= version <= high else False
 
 
 def _quietly(compile_):
@@ -208,36 +319,39 @@ def _digest(path: str) -> bytes:
     return _hash_file(path, st.st_mtime_ns, st.st_size)
 
 
-class _DependencyStamp(_CacheLocator):
-    """Numba's own locator for the function (cache directory, file names) with a source
-    stamp that adds the contents of the modules in :func:`dependencies`."""
+if _CacheLocator is not None:
+    class _DependencyStamp(_CacheLocator):
+        """Numba's own locator for the function (cache directory, file names) with a source
+        stamp that adds the contents of the modules in :func:`dependencies`."""
 
-    def __init__(self, inner: _CacheLocator, module: str):
-        self._inner = inner
-        self._module = module
+        def __init__(self, inner: _CacheLocator, module: str):
+            self._inner = inner
+            self._module = module
 
-    def ensure_cache_path(self):
-        self._inner.ensure_cache_path()
+        def ensure_cache_path(self):
+            self._inner.ensure_cache_path()
 
-    def get_cache_path(self):
-        return self._inner.get_cache_path()
+        def get_cache_path(self):
+            return self._inner.get_cache_path()
 
-    def get_disambiguator(self):
-        return self._inner.get_disambiguator()
+        def get_disambiguator(self):
+            return self._inner.get_disambiguator()
 
-    def get_source_stamp(self):
-        deps = tuple((name, _digest(_source(name))) for name in dependencies(self._module))
-        return self._inner.get_source_stamp(), deps
-
-
-class _DependencyKeyedImpl(CompileResultCacheImpl):
-    def __init__(self, py_func):
-        super().__init__(py_func)
-        self._locator = _DependencyStamp(self._locator, py_func.__module__)
+        def get_source_stamp(self):
+            deps = tuple((name, _digest(_source(name))) for name in dependencies(self._module))
+            return self._inner.get_source_stamp(), deps
 
 
-class DependencyKeyedCache(FunctionCache):
-    """A Numba function cache whose entries go stale when any source in the kernel's
-    :func:`dependencies` changes, not only the kernel's own file."""
+    class _DependencyKeyedImpl(CompileResultCacheImpl):
+        def __init__(self, py_func):
+            super().__init__(py_func)
+            self._locator = _DependencyStamp(self._locator, py_func.__module__)
 
-    _impl_class = _DependencyKeyedImpl
+
+    class DependencyKeyedCache(FunctionCache):
+        """A Numba function cache whose entries go stale when any source in the kernel's
+        :func:`dependencies` changes, not only the kernel's own file."""
+
+        _impl_class = _DependencyKeyedImpl
+else:  # pragma: no cover - depends on the installed Numba
+    DependencyKeyedCache = None

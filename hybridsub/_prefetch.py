@@ -26,14 +26,44 @@ Examples
 
 from __future__ import annotations
 
-from llvmlite import ir
-from llvmlite.binding import llvm_version_info
-from numba.core import cgutils, config, types
+import functools
+
+from llvmlite import binding, ir
+from numba.core import config, types
 from numba.extending import intrinsic
 
 _I32 = ir.IntType(32)
-# the intrinsic's name carries its pointer type: typed pointers up to LLVM 16, opaque after
-_PREFETCH = "llvm.prefetch.p0" if llvm_version_info >= (17,) else "llvm.prefetch.p0i8"
+_BYTE_POINTER = ir.IntType(8).as_pointer()
+_SIGNATURE = ir.FunctionType(ir.VoidType(), [_BYTE_POINTER, _I32, _I32, _I32])
+
+
+def _declare(module: ir.Module) -> ir.Function:
+    # llvmlite names the intrinsic for its own pointer mode (``llvm.prefetch.p0i8`` with typed
+    # pointers, ``llvm.prefetch.p0`` with opaque ones)
+    return module.declare_intrinsic("llvm.prefetch", [_BYTE_POINTER], _SIGNATURE)
+
+
+@functools.lru_cache(maxsize=None)
+def lowers() -> bool:
+    """Whether this LLVM accepts the prefetch as :func:`prefetch` writes it: checked once, on
+    a one-function module parsed and verified by llvmlite. Where not, :func:`prefetch`
+    compiles to nothing (a hint dropped), never a failed kernel.
+
+    Examples
+    --------
+    >>> lowers() in (True, False)
+    True
+    """
+    try:
+        module = ir.Module(name="prefetch_probe")
+        fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [_BYTE_POINTER]), name="probe")
+        builder = ir.IRBuilder(fn.append_basic_block())
+        builder.call(_declare(module), [fn.args[0], ir.Constant(_I32, 0), ir.Constant(_I32, 3), ir.Constant(_I32, 1)])
+        builder.ret_void()
+        binding.parse_assembly(str(module)).verify()
+    except Exception:  # noqa: BLE001 - any refusal by this llvmlite/LLVM
+        return False
+    return True
 
 
 @intrinsic
@@ -43,12 +73,12 @@ def prefetch(typingctx, x, at):
         return None
 
     def codegen(context, builder, signature, args):
-        data = context.make_array(signature.args[0])(context, builder, args[0]).data
-        address = builder.bitcast(builder.gep(data, [args[1]]), ir.IntType(8).as_pointer())
-        fn = cgutils.get_or_insert_function(
-            builder.module, ir.FunctionType(ir.VoidType(), [address.type, _I32, _I32, _I32]), _PREFETCH)
-        # a read (0), kept in every cache level (locality 3), of data (1)
-        builder.call(fn, [address, ir.Constant(_I32, 0), ir.Constant(_I32, 3), ir.Constant(_I32, 1)])
+        if lowers():
+            data = context.make_array(signature.args[0])(context, builder, args[0]).data
+            address = builder.bitcast(builder.gep(data, [args[1]]), _BYTE_POINTER)
+            # a read (0), kept in every cache level (locality 3), of data (1)
+            builder.call(_declare(builder.module),
+                         [address, ir.Constant(_I32, 0), ir.Constant(_I32, 3), ir.Constant(_I32, 1)])
         return context.get_dummy_value()
     return types.void(x, at), codegen
 

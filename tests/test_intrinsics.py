@@ -57,3 +57,20 @@ def test_prefetch_is_emitted_and_changes_no_result():
     ir = next(iter(gather.inspect_llvm().values()))
     assert "llvm.prefetch" in ir
 
+
+
+def test_prefetch_compiles_to_nothing_where_llvm_refuses_it(monkeypatch):
+    """Where this LLVM does not take the intrinsic (``lowers()`` False), a kernel with the
+    hint compiles and runs, without it."""
+    from hybridsub import _prefetch
+
+    assert _prefetch.lowers()  # on the LLVM the project is tested with, the hint is emitted
+    monkeypatch.setattr(_prefetch, "lowers", lambda: False)
+
+    @njit
+    def first(x, idx):
+        prefetch(x, idx[0])
+        return x[idx[0]]
+
+    assert first(np.arange(4.0), np.array([2])) == 2.0
+    assert "llvm.prefetch" not in next(iter(first.inspect_llvm().values()))

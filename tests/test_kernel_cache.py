@@ -185,3 +185,66 @@ def test_kernels_without_parfors_compile_quietly_and_run_serially():
         assert quiet(np.arange(5.0)).tolist() == [0.0, 1.0, 3.0, 6.0, 10.0]
     loud = [str(w.message) for w in caught if "parallel=True" in str(w.message)]
     assert not loud, loud
+
+
+def test_kernels_fall_back_to_plain_caching_where_numbas_internals_moved(tmp_path):
+    """Should a Numba release rename the private cache classes ``_jit`` builds on, ``import
+    hybridsub`` still works: every kernel is plain ``njit(cache=True)``, with one warning."""
+    code = textwrap.dedent("""
+        import warnings
+        import numba.core.caching as caching
+        del caching._CacheLocator
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            import hybridsub
+            from hybridsub._topology import _halfedge_kernels as H
+        import numpy as np
+        said = [str(w.message) for w in caught if "plain cache=True" in str(w.message)]
+        print(len(said), type(H.far_twins._cache).__name__, H.far_twins(np.zeros(6, np.int64)))
+    """)
+    assert _run(code, tmp_path, tmp_path / "cache") == "1 FunctionCache False"
+
+
+def test_no_parfors_is_what_it_says_on_this_numba():
+    """``NO_PARFORS`` leans on undocumented behaviour (a ``ParallelOptions`` object as
+    ``parallel=``, and the text of a warning): on the Numba installed, within the verified
+    range, it must still compile Numba's parallel pipeline with no thread launched and give
+    exactly the warning that ``_quietly`` drops. A release that changes either fails here."""
+    import warnings
+
+    import numpy as np
+
+    from hybridsub._jit import NO_PARFORS, NO_PARFORS_VERIFIED, serial_pipeline
+
+    version = tuple(int(p) for p in numba.__version__.split(".")[:2])
+    low, high = NO_PARFORS_VERIFIED
+    assert low <= version <= high, (f"numba {numba.__version__} is outside the range NO_PARFORS was verified "
+                                    f"on {NO_PARFORS_VERIFIED}: check it and widen the range, or drop it")
+    assert serial_pipeline() is NO_PARFORS
+
+    def scaled(x):
+        out = np.empty_like(x)
+        for i in numba.prange(len(x)):
+            out[i] = 2.0 * x[i]
+        return out
+
+    raw = numba.njit(parallel=NO_PARFORS)(scaled)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert raw(np.arange(3.0)).tolist() == [0.0, 2.0, 4.0]
+    import re
+
+    pattern = "(?s).*'parallel=True' was specified but no transformation"
+    assert any(re.match(pattern, str(w.message)) for w in caught), [str(w.message) for w in caught]
+    llvm = "".join(raw.inspect_llvm().values())
+    assert "do_scheduling" not in llvm  # nothing is handed to Numba's thread pool
+    threaded = numba.njit(parallel=True)(scaled)
+    threaded(np.arange(3.0))
+    assert "do_scheduling" in "".join(threaded.inspect_llvm().values())  # the marker still means threads
+
+
+def test_no_parfors_switch_off_gives_the_plain_pipeline(monkeypatch):
+    from hybridsub._jit import serial_pipeline
+
+    monkeypatch.setenv("HYBRIDSUB_NO_PARFORS", "0")
+    assert serial_pipeline() is False
