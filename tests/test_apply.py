@@ -202,3 +202,28 @@ def test_vector_lanes_multiply_then_add_as_the_scalar_code():
     p = w * x
     assert _lanes_after(np.full(4, -p), w, np.full(4, x)) == (0.0, 0.0, 0.0, 0.0)
     assert _lanes_after(np.arange(4.0), 0.5, np.arange(4.0, 8.0)) == (2.0, 3.5, 5.0, 6.5)
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_the_levels_prefetch_decision_changes_no_bit(monkeypatch, far):
+    """Prefetching is decided once per level (``Level.far_apart``) for its topology, data and
+    matrix product; forced either way it is a hint only: the same faces and the same bits."""
+    from hybridsub._topology.level import Level
+
+    V, V2, r = _refinement("loop-semisharp")
+    monkeypatch.setattr(Level, "far_apart", property(lambda self: far))
+    _, _, forced = _refinement("loop-semisharp")
+    X = np.random.default_rng(2).normal(size=(len(V), 3))
+    assert np.array_equal(forced.faces, r.faces)
+    assert np.array_equal(forced.apply(X), _step_product(r, X))
+    assert _same_csr(forced.matrix, r.matrix)
+
+
+def test_far_apart_tells_shuffled_faces_from_ordered_ones():
+    from hybridsub._topology import build_level
+
+    V, F = hybridsub.load_example()
+    F = hybridsub.refine(F, levels=4, scheme="loop").faces  # > 32k faces, written in order
+    assert not build_level(F, int(F.max()) + 1).far_apart
+    shuffled = F[np.random.default_rng(0).permutation(len(F))]
+    assert build_level(shuffled, int(F.max()) + 1).far_apart

@@ -8,6 +8,8 @@ from hypothesis import strategies as st
 
 from hybridsub._topology import _classify_kernels as C
 from hybridsub._topology import _kernels as K
+import hybridsub
+import strategies as ms
 from hybridsub import refine
 from hybridsub._input.gate import open_gate
 from hybridsub._refiner.loop import walk
@@ -241,3 +243,20 @@ def test_far_twins_tells_scattered_faces_from_ordered_ones():
     shuffled = F[np.random.default_rng(0).permutation(len(F))]
     assert far_twins(build_level(shuffled, (k + 1) ** 2).twin)
     assert not far_twins(build_level(shuffled[:30000], (k + 1) ** 2).twin)  # too small to matter
+
+
+@pytest.mark.parametrize("valence", [40, 200])
+def test_twins_of_a_high_valence_fan_match_brute_force(valence):
+    """A vertex with more than 64 halfedges around it is matched by sorting its group (the
+    in-place heapsort); its twins must be the brute-force pairing, and a duplicated face
+    there is still found."""
+    from hybridsub._topology import build_level
+
+    _, F = ms.fan(valence, closed=True)
+    F = F[np.random.default_rng(valence).permutation(len(F))]
+    twin = build_level(F, int(F.max()) + 1).twin
+    where = {(int(F[h // 3, h % 3]), int(F[h // 3, (h % 3 + 1) % 3])): h for h in range(3 * len(F))}
+    expected = [where.get((w, u), -1) for (u, w) in where]
+    assert twin.tolist() == expected
+    with pytest.raises(hybridsub.MeshError):
+        build_level(np.vstack([F, F[:1]]), int(F.max()) + 1)

@@ -17,15 +17,14 @@ from numba import prange
 from .._jit import NO_PARFORS, kernel, threaded_and_serial
 from .._prefetch import prefetch
 from .._rules.step_rules import EDGE_TRISECT, KOBBELT_TRISECTION, edge_weights
-from .._topology import dest, edge_sharpness, far_twins, opposite, origin, owned_edge, owned_ends_in
+from .._topology import dest, edge_sharpness, opposite, origin, owned_edge, owned_ends_in
 from ._simd import lane, madd4, vzero
 
 _T0, _T1, _T2 = KOBBELT_TRISECTION
 _THIRD = 1.0 / 3.0
 _U1, _U2, _U3, _U4 = np.uintp(1), np.uintp(2), np.uintp(3), np.uintp(4)  # unsigned offsets: no negative-index test
-_PREFETCH_FROM = 2**17  # values of X (1 MB, a core's L2 cache): below, prefetching only costs
 _ROW_AHEAD = 16  # entries of A between prefetching a row of B and reading it
-_AHEAD = 32  # halfedges between a prefetch and its use (armadillo's last Loop step: 16 → 26, 32 and 64 → 23 ms)
+_AHEAD = 32  # halfedges between a prefetch and its use (docs/performance.md, "Kernel design")
 
 
 @kernel(inline="always")
@@ -56,8 +55,7 @@ def _has_edge_points(face_point, n, n_new):
 
 # Rows of the step's data, X[·] weighted, each column summed left to right as written (the
 # bits of the loop over columns); three columns unrolled, with unsigned indices (Numba tests
-# a signed index for a negative value on every access): armadillo x 3, one thread, same
-# process, the steps 71 -> 58 ms (Loop) and 27 -> 20 ms (sqrt3).
+# a signed index for a negative value on every access; docs/performance.md, "Kernel design").
 
 
 @kernel(inline="always")
@@ -124,7 +122,7 @@ def _sum4(out, r, wa, a, wb, b, wc, c, wd, d, X):
 def _neighbour_coefficient(v, s, coef):
     """Vertex ``v``'s weight of its neighbour across an edge of sharpness ``s``. The vertex
     pass of :func:`_apply_step` tests ``s == 0.0`` (most edges) before calling it: the same
-    test in here compiles slower (armadillo's last Loop step, one thread: 1-2 ms of 38)."""
+    test in here compiles to a slower loop."""
     c = coef[1, v]
     if s > 0.0:
         c += coef[2, v]
@@ -133,7 +131,7 @@ def _neighbour_coefficient(v, s, coef):
     return c
 
 
-def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks):
+def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coef, bnext, bprev, out, chunks, fetch):
     """Fill ``out`` (n_new, k) with the next level's data ``S @ X``, without forming S.
 
     Old vertices gather from their neighbours in edge order. ``chunks`` threads each take
@@ -162,19 +160,12 @@ def _apply_step(X, F, twin, hsharp, has_tags, hkind, edge_point, face_point, coe
                     cw = coef[1, w] if s == 0.0 else _neighbour_coefficient(w, s, coef)
                     if cw != 0.0:
                         _add1(out, w, cw, u, X)
-    fetch = X.size > _PREFETCH_FROM and far_twins(twin)
     n_half = 3 * m if _has_edge_points(face_point, n, out.shape[0]) else 0  # (prange(a if c else b) runs serially)
-    # On one thread plain loops: the threaded loops' machinery costs them a fifth there.
-    if chunks == 1:
-        for h in range(n_half):
-            _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch)
-        for f in range(m):
-            _face_point_row(f, X, F, face_point, out)
-    else:
-        for h in prange(n_half):
-            _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch)
-        for f in prange(m):
-            _face_point_row(f, X, F, face_point, out)
+    # one thread runs the serial twin, where these loops are plain ones
+    for h in prange(n_half):
+        _edge_point_row(h, X, F, twin, hsharp, has_tags, hkind, edge_point, bnext, bprev, out, fetch)
+    for f in prange(m):
+        _face_point_row(f, X, F, face_point, out)
 
 
 @kernel(inline="always")
@@ -359,7 +350,7 @@ def product_bound(a_indptr, a_indices, b_indptr, n_cols):
 
 
 @kernel(parallel=True)
-def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, counts):
+def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, counts, fetch):
     """``counts[i]``: the distinct columns of row i of ``A @ B`` (CSR patterns), ``chunks``
     ranges of rows in parallel."""
     m = len(a_indptr) - 1
@@ -369,7 +360,8 @@ def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, co
             n = 0
             i32 = np.int32(i)
             for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
-                _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_indices)
+                if fetch:
+                    _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_indices)
                 j = np.uintp(a_indices[q])
                 for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
                     k = np.uintp(b_indices[p])
@@ -381,7 +373,7 @@ def product_pattern(a_indptr, a_indices, b_indptr, b_indices, n_cols, chunks, co
 
 @kernel(parallel=True)
 def product_fill(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_cols, chunks, c_indptr, c_indices,
-                 c_data, kept):
+                 c_data, kept, fetch):
     """Row i of ``A @ B`` into ``c_indices``, ``c_data`` from ``c_indptr[i]``, columns sorted,
     the sums that are exactly zero dropped (``kept[i]`` entries left), as SciPy's product
     followed by ``sort_indices``: each sum starts at zero and adds ``A[i, j] * B[j, k]`` in
@@ -395,7 +387,8 @@ def product_fill(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_col
             n = np.uintp(0)
             i32 = np.int32(i)
             for q in range(np.uintp(a_indptr[i]), np.uintp(a_indptr[i + 1])):
-                _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_data)
+                if fetch:
+                    _prefetch_b_row(q, a_indices, b_indptr, b_indices, b_data)
                 j = np.uintp(a_indices[q])
                 v = a_data[q]
                 for p in range(np.uintp(b_indptr[j]), np.uintp(b_indptr[j + _U1])):
@@ -488,9 +481,8 @@ def _coded_apply3(indptr, indices, codes, weights, x4, out):
     in the lanes of one vector register (``_simd``), each lane a multiply then an add in the
     row's stored order: the scalar loop's bits. Entries are counted by an unsigned index
     instead of views of the row: a signed one costs each access Numba's negative-index test,
-    a view per row its bounds arithmetic (rows hold ten entries on average). Armadillo × 3
-    Loop's composite, one thread: 34–45 ms with three scalar chains, 27–29 with the vector,
-    20–22 without the views."""
+    a view per row its bounds arithmetic (rows hold ten entries on average; the measured
+    effect is in docs/performance.md, "Kernel design")."""
     for r in prange(indptr.shape[0] - 1):
         q = np.uintp(indptr[r])
         end = np.uintp(indptr[r + 1])

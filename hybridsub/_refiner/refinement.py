@@ -64,6 +64,7 @@ class RefinementStep:
     face_parent: np.ndarray
     uv_faces: np.ndarray | None = None
     uv_matrix: sp.csr_matrix | None = None
+    _far_apart: bool = field(default=False, repr=False)  # level k's Level.far_apart
 
     @property
     def n_vertices(self) -> int:
@@ -147,7 +148,7 @@ class Refinement:
             S = sp.identity(self.n_coarse, format="csr", dtype=np.float64)
             for st in self.steps:
                 check_product(st.matrix, S, self.max_memory)  # size guard
-                S = product(st.matrix, S)
+                S = product(st.matrix, S, st._far_apart)
             self._cache["matrix"] = S
         return self._cache["matrix"]
 
@@ -417,7 +418,7 @@ def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement
             uv_pairs, uv_sharp = child_creases(s.uv.level, s.uv.plan)
             uv_steps.append(RefinementStep(uv_faces, uv_matrix, uv_pairs, uv_sharp, mask, uv_corners, parent))
         steps.append(RefinementStep(s.faces, step_matrix(s.level, s.plan), pairs, sharp, mask, corners, parent,
-                                    uv_faces, uv_matrix))
+                                    uv_faces, uv_matrix, s.level.far_apart))
     uv = None
     if inp.uv is not None:
         uv_faces = uv_steps[-1].faces if uv_steps else inp.uv.faces.copy()

@@ -44,9 +44,9 @@ def apply_step(level: Level, plan: StepPlan, X: np.ndarray) -> np.ndarray:
     X = np.ascontiguousarray(X, dtype=np.float64)
     out = np.empty((plan.n_new, X.shape[1]), np.float64)
     if use_threads(level.n_faces):
-        K.apply_step(X, *step_arguments(level, plan), out, numba.get_num_threads())
+        K.apply_step(X, *step_arguments(level, plan), out, numba.get_num_threads(), level.far_apart)
     else:
-        K.apply_step_serial(X, *step_arguments(level, plan), out, 1)
+        K.apply_step_serial(X, *step_arguments(level, plan), out, 1, level.far_apart)
     return out
 
 
@@ -60,10 +60,11 @@ def apply_matrix(S: sp.csr_matrix, X: np.ndarray, out: np.ndarray | None = None)
     return out
 
 
-def product(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
+def product(A: sp.csr_matrix, B: sp.csr_matrix, fetch: bool = False) -> sp.csr_matrix:
     """``A @ B`` for CSR matrices, its columns sorted: SciPy's ``(A @ B)`` after
     ``sort_indices()`` to the bit (the same sums in the same order, exact zeros dropped),
-    its rows computed on threads.
+    its rows computed on threads. ``fetch``: prefetch the rows of B that A's columns pick
+    (the step's level's :attr:`~hybridsub._topology.Level.far_apart`, for a step matrix A).
 
     Examples
     --------
@@ -83,7 +84,7 @@ def product(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
     a_ptr, a_idx, b_ptr, b_idx = (a.astype(np.int64 if wide else np.int32, copy=False)
                                   for a in (A.indptr, A.indices, B.indptr, B.indices))
     counts = np.empty(m, np.int64)
-    K.product_pattern(a_ptr, a_idx, b_ptr, b_idx, n_cols, chunks, counts)
+    K.product_pattern(a_ptr, a_idx, b_ptr, b_idx, n_cols, chunks, counts, fetch)
     indptr = np.zeros(m + 1, np.int64)
     np.cumsum(counts, out=indptr[1:])
     nnz = int(indptr[-1])
@@ -92,7 +93,7 @@ def product(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
     data = np.empty(nnz, np.float64)
     kept = np.empty(m, np.int64)
     K.product_fill(a_ptr, a_idx, np.asarray(A.data, np.float64), b_ptr, b_idx, np.asarray(B.data, np.float64), n_cols,
-                   chunks, indptr, indices, data, kept)
+                   chunks, indptr, indices, data, kept, fetch)
     if int(kept.sum()) < nnz:  # exact zero sums were dropped: close the gaps
         keep = np.arange(nnz) - np.repeat(indptr[:-1], counts) < np.repeat(kept, counts)
         indices, data = indices[keep], data[keep]
@@ -108,8 +109,7 @@ def in_read_order(steps: list[sp.csr_matrix]) -> list[sp.csr_matrix]:
 
     Rows keep their entries in order, so multiplying the chain gives the same bits. A step
     numbers its new vertices edge by edge, so the next step's rows read a level of 10⁵–10⁶
-    vertices all over; in read order they walk it almost in sequence (armadillo, three Loop
-    steps, one frame on one thread: 70–118 → 54–101 ms in four same-process pairs).
+    vertices all over; in read order they walk it almost in sequence.
 
     Examples
     --------

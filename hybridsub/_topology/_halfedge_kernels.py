@@ -80,10 +80,9 @@ def owned_ends_in(F, twin, f, i, lo, hi):
 @kernel(inline="always")
 def far_twins(twin):
     """Whether the faces across this level's edges lie far from their own in memory: of 1024
-    halfedges evenly spread, more than one in eight has its twin 4096 faces or more away
-    (armadillo, a scan: 21–75 % at each level; fandisk and the mannequin, whose faces were
-    written in order: at most 10 %), on a level of more than 32k faces. Only there does
-    prefetching the reads across edges pay; elsewhere the hint only costs (3–10 %)."""
+    halfedges evenly spread, more than one in eight has its twin 4096 faces or more away, on
+    a level of more than 32k faces. Only there does prefetching the reads across edges pay;
+    elsewhere the hint only costs (docs/performance.md, "Kernel design")."""
     n = twin.shape[0]
     if n <= 3 * 2**15:
         return False

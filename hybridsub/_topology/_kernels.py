@@ -130,15 +130,43 @@ def halfedge_twins(F, n_vertices, twin, key, half):
     return OK, -1
 
 
+@kernel
+def _sort_pairs(key, half, a, b):
+    """Sort ``key[a:b]``, ``half[a:b]`` in place by (key, half): a heapsort (n log n, no
+    allocation; NumPy's sorts cost the first call seconds of compiling)."""
+    n = b - a
+    for root in range(n // 2 - 1, -1, -1):
+        _sift_down(key, half, a, root, n)
+    for end in range(n - 1, 0, -1):
+        key[a], key[a + end] = key[a + end], key[a]
+        half[a], half[a + end] = half[a + end], half[a]
+        _sift_down(key, half, a, 0, end)
+
+
+@kernel(inline="always")
+def _sift_down(key, half, a, root, n):
+    while True:
+        child = 2 * root + 1
+        if child >= n:
+            return
+        c, r = a + child, a + root
+        if child + 1 < n and (key[c + 1] > key[c] or (key[c + 1] == key[c] and half[c + 1] > half[c])):
+            child += 1
+            c += 1
+        if key[r] > key[c] or (key[r] == key[c] and half[r] >= half[c]):
+            return
+        key[r], key[c] = key[c], key[r]
+        half[r], half[c] = half[c], half[r]
+        root = child
+
+
 @kernel(inline="always")
 def _match_group(a, b, key, half, twin):
     """Pair the halfedges ``key[a:b]``, ``half[a:b]`` of one group into twins; returns
     (OK, −1) or an error and its halfedge. A group longer than ``_SORT_GROUP_FROM`` is
     sorted by key first, then only neighbours are compared."""
     if b - a > _SORT_GROUP_FROM:
-        order = np.argsort(key[a:b], kind="mergesort")
-        key[a:b] = key[a:b][order]
-        half[a:b] = half[a:b][order]
+        _sort_pairs(key, half, a, b)
         for k in range(a, b - 1):
             if key[k] >> 1 == key[k + 1] >> 1:
                 err = _pair(twin, key[k], half[k], key[k + 1], half[k + 1])
@@ -325,9 +353,8 @@ def boundary_links(F, twin):
     return bnext, bprev
 
 
-# Prefetching the faces across edges pays where they lie far apart (far_twins); armadillo's
-# three levels, one thread, same process: Loop 61 -> 49 ms, sqrt3 40 -> 28 ms (the last
-# level's twins included).
+# Prefetching the faces across edges pays where they lie far apart (Level.far_apart; the
+# measured effect is in docs/performance.md, "Kernel design").
 _FACES_AHEAD = 16
 
 
@@ -490,12 +517,11 @@ def _prefetch_faces_across(h0, twin, hkind, face_point, face_sharp, first):
             prefetch(face_sharp, t // 3)
 
 
-def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs):
+def _emit_topology(twin, hsharp, has_tags, hkind, face_point, trisected, face_sharp, first, tw, hs, fs, fetch):
     """Fill the next level's twins ``tw``, halfedge sharpness ``hs`` (zeroed; when
     ``has_tags``: children of creases with s > 1 carry s − 1) and sharp-face mask ``fs``
     (zeroed), derived from this level's (no search)."""
     m = face_sharp.shape[0]
-    fetch = far_twins(twin)
     for f in prange(m):
         if fetch and f + _FACES_AHEAD < m:
             _prefetch_faces_across(3 * (f + _FACES_AHEAD), twin, hkind, face_point, face_sharp, first)

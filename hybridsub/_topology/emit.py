@@ -46,7 +46,7 @@ def child_level(level: Level, plan: StepPlan, want_topology: bool = True):
     if want_topology:
         (K.emit_topology if big else K.emit_topology_serial)(
             level.twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, plan.hkind, plan.face_point,
-            plan.trisected, face_sharp, first, twin, hsharp, child_sharp)
+            plan.trisected, face_sharp, first, twin, hsharp, child_sharp, level.far_apart)
         child = Level(faces, plan.n_new, twin, hsharp if has_tags else None, child_sharp)
     return faces, child, offsets if want_topology else None
 

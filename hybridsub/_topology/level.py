@@ -51,6 +51,14 @@ class Level:
         return self.faces.shape[0]
 
     @cached_property
+    def far_apart(self) -> bool:
+        """Whether the faces across this level's edges lie far from their own in memory
+        (:func:`far_twins`): the one test, made once per level, that decides whether the
+        level's kernels prefetch what they read across edges (its topology, its data, and
+        the product of its step matrix with the matrices before it)."""
+        return bool(K.far_twins(self.twin)) if len(self.twin) else False
+
+    @cached_property
     def _edges(self):
         edge_of = np.empty(len(self.twin), np.int64)  # NumPy's pages: huge ones for big levels
         owner = np.empty(len(self.twin), np.int64)
