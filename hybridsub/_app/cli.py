@@ -364,7 +364,8 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--threads", type=_positive, metavar="N",
                     help="threads for the kernels (default: every core); the output does not depend on it")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo, _add_fit, _add_decompose):
+    for add in (_add_subdivide, _add_batch, _add_compare, _add_info, _add_demo, _add_fit, _add_decompose,
+                _add_warmup):
         add(sub)
     return ap
 
@@ -516,6 +517,25 @@ def _add_decompose(sub) -> None:
     _scheme_option(d)
     d.add_argument("-q", "--quiet", action="store_true")
     d.set_defaults(func=cmd_decompose)
+
+
+def cmd_warmup(a) -> int:
+    from .warmup import warm_up
+
+    if not a.quiet:
+        print("hybridsub: compiling every kernel ahead (once per machine and install)", file=sys.stderr)
+    seconds = warm_up(quiet=a.quiet)
+    if not a.quiet:
+        print(f"hybridsub: kernels ready in {seconds:.1f} s; later calls compile nothing", file=sys.stderr)
+    return 0
+
+
+def _add_warmup(sub) -> None:
+    w = sub.add_parser("warmup", help="compile every kernel ahead (for images, CI and clusters)",
+                       description="Runs one small call of every kind, so that Numba compiles and caches every "
+                                   "kernel now (NUMBA_CACHE_DIR, else __pycache__) and no later call waits for it.")
+    w.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    w.set_defaults(func=cmd_warmup)
 
 
 def main(argv=None) -> int:
