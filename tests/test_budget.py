@@ -5,6 +5,7 @@ import math
 import os
 
 import numpy as np
+import scipy.sparse as sp
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -196,9 +197,13 @@ def test_parse_limit_refuses(bad, err):
 
 
 def test_zero_levels_and_empty_meshes_need_no_budget():
-    F = ms.icosahedron()[1]
-    hybridsub.refine(F, levels=0, max_memory=0)
-    hybridsub.refine(np.empty((0, 3), int), levels=5, max_memory=0)
+    V, F = ms.icosahedron()
+    r = hybridsub.refine(F, levels=0, max_memory=0)  # nothing to allocate: nothing refused
+    assert np.array_equal(r.faces, F) and (r.matrix != sp.identity(len(V))).nnz == 0
+    empty = hybridsub.refine(np.empty((0, 3), int), levels=5, max_memory=0)
+    assert empty.faces.shape == (0, 3) and empty.n_vertices == 0 and len(empty.steps) == 5
+    with pytest.raises(OutputTooLargeError):  # while one step with no memory at all is refused
+        hybridsub.refine(F, levels=1, max_memory=0)
 
 
 def test_composite_matrix_is_checked():

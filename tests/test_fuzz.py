@@ -67,14 +67,20 @@ def check_valid(scheme, V, F, tags):
     assert ms.euler(len(V2), F2) == ms.euler(len(V), F)
     unused = np.setdiff1d(np.arange(len(V)), F)
     assert np.array_equal(V2[unused], V[unused])
-    # the budget's estimate bounds what was made
+    # the budget's estimate (what refine checks against the memory limit) bounds what was made
+    from hybridsub._input.gate import open_gate
     from hybridsub._refiner import budget as _budget
+    from hybridsub._topology import plan_step
 
     r = hybridsub.refine(F, levels=levels, scheme=scheme, n_vertices=len(V), **tags)
     assert r.n_vertices == len(V2) and np.array_equal(r.faces, F2)
     nnz = sum(s.matrix.nnz for s in r.steps)
-    assert nnz > 0
-    assert _budget.Budget(levels, scheme).limit > 0
+    inp = open_gate(F, tags.get("sharp_edges"), levels, scheme=scheme, sharpness=tags.get("sharpness"),
+                    sharp_faces=tags.get("sharp_faces"), corners=tags.get("corners"), n_vertices=len(V))
+    if inp.n_faces:
+        est = _budget.estimate(_budget.counts_of(inp.level, plan_step(inp.level, inp.corner, scheme, 1, "loop")),
+                               scheme, 1, inp.levels)
+        assert est.faces >= len(F2) and est.vertices >= len(V2) and est.nnz >= nnz, (est, len(F2), len(V2), nnz)
     # non_manifold="cut" on a valid mesh changes nothing, bit for bit
     V3, F3, S3 = hybridsub.subdivide(V, F, levels=levels, scheme=scheme, return_matrix=True,
                                      non_manifold="cut", **tags)
