@@ -13,19 +13,20 @@ def example_names() -> list[str]:
     """The names of the shipped example meshes.
 
     >>> example_names()
-    ['fandisk']
+    ['cube', 'fandisk']
     """
     data = resources.files("hybridsub").joinpath("data")
     return sorted(p.name[:-4] for p in data.iterdir() if p.name.endswith(".off"))
 
 
 def example_path(name: str = "fandisk") -> str:
-    """Path of a shipped example mesh (``"fandisk"``: 6475 vertices, 12946 faces).
+    """Path of a shipped example mesh (``"fandisk"``: 6475 vertices, 12946 faces; ``"cube"``:
+    866 vertices, 1728 faces).
 
     >>> example_path("bunny")
     Traceback (most recent call last):
     ...
-    ValueError: no example mesh named 'bunny'; the examples are: 'fandisk'
+    ValueError: no example mesh named 'bunny'; the examples are: 'cube', 'fandisk'
     """
     names = example_names()
     if name not in names:
@@ -39,8 +40,9 @@ def load_example(name: str = "fandisk") -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     name : str
-        The example's name; ``"fandisk"`` (the default, 6475 vertices, 12946 faces, the CAD
-        part of Hoppe et al. with 722 creases at 30°) is the one shipped.
+        The example's name: ``"fandisk"`` (the default, 6475 vertices, 12946 faces, the CAD
+        part of Hoppe et al. with 722 creases at 30°) or ``"cube"`` (866 vertices, 1728 faces:
+        a meshed CAD cube, its edges creases at 30°, small enough for quick examples).
 
     Raises
     ------
