@@ -79,20 +79,31 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
     if os.path.isdir(path):
         raise MeshError(f"{path}: is a directory, not a mesh file")
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".obj":
-        mesh = read_obj(path, triangulate)
-    elif ext == ".ply":
-        mesh = read_ply_mesh(path, triangulate)
-    elif ext == ".off":
-        mesh = read_off_mesh(path, triangulate)
-    elif ext == ".npz":
-        mesh = read_npz(path)
-    elif _through_meshio(path):
-        mesh = read_meshio(path, triangulate)
-    else:
-        mesh = read_trimesh(path, ext)
+    try:
+        mesh = _read_format(path, ext, triangulate)
+    except (MeshError, OSError, ImportError):
+        raise
+    except MemoryError:
+        raise MeshError(f"{path}: not enough memory to read it ({os.path.getsize(path):,} bytes)") from None
+    except Exception as e:  # a damaged file the reader's own checks missed: still one error naming the file
+        raise MeshError(f"{path}: cannot be read as {ext.lstrip('.').upper() or 'a mesh'}: the file is damaged "
+                        f"({type(e).__name__}: {e})") from None
     return check_read(path, mesh)
 
+
+def _read_format(path: str, ext: str, triangulate: bool) -> TaggedMesh:
+    """The reader of ``ext``'s format applied to ``path``."""
+    if ext == ".obj":
+        return read_obj(path, triangulate)
+    if ext == ".ply":
+        return read_ply_mesh(path, triangulate)
+    if ext == ".off":
+        return read_off_mesh(path, triangulate)
+    if ext == ".npz":
+        return read_npz(path)
+    if _through_meshio(path):
+        return read_meshio(path, triangulate)
+    return read_trimesh(path, ext)
 
 
 def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayLike | None = None, *,
