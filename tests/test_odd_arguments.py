@@ -1,0 +1,96 @@
+"""Odd arguments to the newer API (issue 31, section 4): each answered by the right result or
+one clear error naming the argument — fit at extreme scales, degenerate and partial inputs,
+multiresolution details that belong to another refinement, and the option keywords every entry
+point takes through the one gate."""
+
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import hybridsub
+from hybridsub import MeshError
+from hybridsub._io import read_off
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+V, F = read_off(os.path.join(DATA, "octahedron.off"))
+R2 = hybridsub.refine(F, levels=2)
+P = R2.apply(V * [1.0, 1.5, 2.0])  # a stretched octahedron's level 2: the level-2 fit is exact
+
+
+# ----------------------------------------------------------------------------------------------
+# fit
+
+
+def test_fit_is_the_same_at_any_scale():
+    """The fit runs on normalised coordinates: at 1e200 and 1e-200 it finds the unit fit,
+    scaled (no overflow claiming convergence at rms=inf, no 'negative dimensions')."""
+    unit = hybridsub.fit(F, P, V0=V, levels=2)
+    assert unit.converged and unit.rms < 1e-9
+    for s in (1e200, 1e-200):
+        res = hybridsub.fit(F, P * s, V0=V * s, levels=2)
+        assert res.converged and np.isfinite(res.rms) and res.rms < 1e-9 * s
+        assert np.allclose(res.vertices / s, unit.vertices, atol=1e-9)
+        assert np.all(np.isfinite(res.history["rms"])) and np.allclose(res.history["rms"] / s, unit.history["rms"],
+                                                                       rtol=1e-6, atol=1e-12)
+
+
+def test_fit_refuses_what_cannot_be_fitted():
+    with pytest.raises(ValueError, match="smoothness 1e\\+300 is more than"):
+        hybridsub.fit(F, P, V0=V, levels=2, smoothness=1e300)
+    with pytest.raises(MeshError, match="V0 has no area"):
+        hybridsub.fit(F, P, V0=np.zeros_like(V), levels=2)
+    with pytest.raises(MeshError, match="F has no faces"):
+        hybridsub.fit(np.empty((0, 3), np.int64), P, V0=V, levels=2)
+    with pytest.raises(TypeError, match="max_iterations must be a number, got None"):
+        hybridsub.fit(F, P, V0=V, levels=2, max_iterations=None)
+    with pytest.raises(TypeError, match="smoothness must be a number"):
+        hybridsub.fit(F, P, V0=V, levels=2, smoothness="1")
+    with pytest.raises(MeshError, match="span more than a double"):
+        hybridsub.fit(F, np.vstack([P, [[-1e308, 0, 0], [1e308, 0, 0]]]), V0=V, levels=2)
+
+
+def test_fit_with_an_unused_vertex_keeps_it_where_it_is(tmp_path):
+    spare = [[5.0, -7.0, 3.0]]
+    V7 = np.vstack([V, spare])
+    res = hybridsub.fit(F, P, V0=V7, levels=2)
+    want = hybridsub.fit(F, P, V0=V, levels=2)
+    assert res.converged and np.array_equal(res.vertices[6], spare[0])
+    assert np.allclose(res.vertices[:6], want.vertices, atol=1e-12)
+    with pytest.raises(MeshError, match="at least 6"):
+        hybridsub.fit(F, P, V0=V[:5], levels=2)
+    # the command line fits such a control file, too
+    from hybridsub._app.cli import main
+
+    hybridsub.write_mesh(tmp_path / "control.obj", V7, F)
+    np.savetxt(tmp_path / "target.xyz", P)
+    assert main(["fit", str(tmp_path / "control.obj"), str(tmp_path / "target.xyz"), "-o", str(tmp_path / "out.obj"),
+                 "--levels", "2", "-q"]) == 0
+    out = hybridsub.read_mesh(tmp_path / "out.obj")
+    assert np.allclose(out.vertices, res.vertices, atol=1e-9)
+
+
+def test_fit_with_fewer_points_than_unknowns_warns():
+    with pytest.warns(UserWarning, match="4 points for 18 unknowns .* underdetermined"):
+        hybridsub.fit(F, P[:4], V0=V, levels=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        hybridsub.fit(F, P[:4], V0=V, levels=2, smoothness=1.0, max_iterations=2)  # regularised: no warning
+        hybridsub.fit(F, P, V0=V, levels=2, max_iterations=2)
+
+
+def test_fit_takes_feature_angle():
+    """fit(feature_angle=) keeps the detected creases sharp: the same fit as with the detected tags."""
+    rng = np.random.default_rng(0)
+    Vc = np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+    Fc = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                   [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+    feat = hybridsub.detect_features(Vc, Fc, angle=30)
+    r = hybridsub.refine(Fc, feat.sharp_edges, levels=2, corners=feat.corners)
+    pts = r.apply(Vc) + 1e-3 * rng.normal(size=(r.n_vertices, 3))
+    got = hybridsub.fit(Fc, pts, V0=Vc, levels=2, feature_angle=30, max_iterations=3)
+    want = hybridsub.fit(Fc, pts, feat.sharp_edges, corners=feat.corners, V0=Vc, levels=2, max_iterations=3)
+    assert np.allclose(got.vertices, want.vertices, atol=1e-12)
+    plain = hybridsub.fit(Fc, pts, V0=Vc, levels=2, max_iterations=3)
+    assert not np.allclose(plain.vertices, want.vertices, atol=1e-6)
