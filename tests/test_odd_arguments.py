@@ -94,3 +94,50 @@ def test_fit_takes_feature_angle():
     assert np.allclose(got.vertices, want.vertices, atol=1e-12)
     plain = hybridsub.fit(Fc, pts, V0=Vc, levels=2, max_iterations=3)
     assert not np.allclose(plain.vertices, want.vertices, atol=1e-6)
+
+
+# ----------------------------------------------------------------------------------------------
+# multiresolution details
+
+
+def test_reconstruct_refuses_details_of_another_refinement():
+    rng = np.random.default_rng(1)
+    X = R2.apply(V) + 0.01 * rng.normal(size=(R2.n_vertices, 3))
+    coarse, details = R2.decompose(X)
+    assert np.abs(R2.reconstruct(coarse, details) - X).max() < 1e-12
+    assert details.fingerprint and hybridsub.refine(F, levels=2).decompose(X)[1].fingerprint == details.fingerprint
+    warren = hybridsub.refine(F, levels=2, scheme="loop", loop_weights="warren")
+    loop = hybridsub.refine(F, levels=2, scheme="loop")
+    c, d = loop.decompose(loop.apply(V) + 0.01 * rng.normal(size=(loop.n_vertices, 3)))
+    with pytest.raises(ValueError, match="another refinement"):
+        warren.reconstruct(c, d)  # same sizes, other weights: error 0.019 before
+    perm = np.array([3, 0, 5, 1, 4, 2])
+    relabelled = hybridsub.refine(perm[F], levels=2)
+    with pytest.raises(ValueError, match="another refinement"):
+        relabelled.reconstruct(coarse, details)
+    creased = hybridsub.refine(F, [[0, 1]], levels=2)
+    with pytest.raises(ValueError, match="another refinement"):
+        creased.reconstruct(coarse, details)
+
+
+def test_reconstruct_refuses_nan_details():
+    coarse, details = R2.decompose(R2.apply(V))
+    levels = list(details.levels)
+    levels[1] = levels[1].copy()
+    levels[1][7, 2] = np.nan
+    bad = hybridsub._fit.multires.MultiresDetails(tuple(levels), details.local_frames, details.shape,
+                                                  details.fingerprint)
+    with pytest.raises(ValueError, match=r"details\[1\] must be finite; row 7"):
+        R2.reconstruct(coarse, bad)
+
+
+@pytest.mark.parametrize("s", [1e200, 1e-200])
+def test_multires_round_trip_at_any_scale(s):
+    rng = np.random.default_rng(2)
+    X = (R2.apply(V) + 0.01 * rng.normal(size=(R2.n_vertices, 3)))
+    coarse, details = R2.decompose(X)
+    coarse_s, details_s = R2.decompose(X * s)
+    assert np.allclose(coarse_s / s, coarse, atol=1e-12)
+    for a, b in zip(details_s, details):
+        assert np.allclose(a / s, b, atol=1e-12)  # the same frames at any scale
+    assert np.abs(R2.reconstruct(coarse_s, details_s) / s - X).max() < 1e-12
