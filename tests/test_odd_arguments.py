@@ -141,3 +141,13 @@ def test_multires_round_trip_at_any_scale(s):
     for a, b in zip(details_s, details):
         assert np.allclose(a / s, b, atol=1e-12)  # the same frames at any scale
     assert np.abs(R2.reconstruct(coarse_s, details_s) / s - X).max() < 1e-12
+
+
+def test_project_takes_max_iterations_and_max_iter_is_deprecated():
+    s = hybridsub.LimitSurface(V, F)
+    pts = 1.1 * V[:2] + 0.05
+    want = s.project(pts, max_iterations=30)
+    with pytest.warns(DeprecationWarning, match="max_iterations"):
+        old = s.project(pts, max_iter=30)
+    for a, b in zip(want, old):
+        assert np.array_equal(a, b)

@@ -3,6 +3,8 @@ derivatives, normals and closest points; every value a sparse row over the contr
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -236,12 +238,15 @@ class LimitSurface:
         norm = np.linalg.norm(N, axis=1, keepdims=True)
         return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
 
-    def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iter: int = 30):
+    def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iterations: int = 30,
+                max_iter: int | None = None):
         """Closest points of the limit surface: ``(face, bary, Q, dist)``.
 
         ``dist`` is signed: positive on the side the normals point to. Seeds come from a dense
         sampling of the surface; Gauss–Newton on (face, u, v) then walks across face
-        boundaries to the foot point (``docs/limit.md``).
+        boundaries to the foot point (``docs/limit.md``). ``max_iterations``: the most
+        Gauss–Newton steps per point (the name :func:`hybridsub.fit` uses; ``max_iter`` is its
+        deprecated alias).
 
         Examples
         --------
@@ -254,6 +259,11 @@ class LimitSurface:
         >>> bool(np.allclose(Q, P, atol=1e-12)), bool(np.isclose(dist[0], 0.01, atol=1e-12))
         (True, True)
         """
+        if max_iter is not None:
+            warnings.warn("LimitSurface.project(max_iter=) is deprecated: use max_iterations= (the name fit uses)",
+                          DeprecationWarning, stacklevel=2)
+            max_iterations = max_iter
+        max_iter = max_iterations
         X = self._V if vertices is None else as_vertices(vertices)
         if len(X) != self._inp.n_vertices:
             raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got {len(X)}")
