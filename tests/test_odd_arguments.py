@@ -151,3 +151,55 @@ def test_project_takes_max_iterations_and_max_iter_is_deprecated():
         old = s.project(pts, max_iter=30)
     for a, b in zip(want, old):
         assert np.array_equal(a, b)
+
+
+# ----------------------------------------------------------------------------------------------
+# the same option keywords through the one gate
+
+CUBE_V = np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+CUBE_F = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                   [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+FACES, BARY = [0, 5, 9], [[1 / 3, 1 / 3, 1 / 3], [0.2, 0.3, 0.5], [0.6, 0.4, 0.0]]
+
+
+def test_limit_surface_and_limit_matrix_take_feature_angle():
+    feat = hybridsub.detect_features(CUBE_V, CUBE_F, angle=30)
+    want = hybridsub.LimitSurface(CUBE_V, CUBE_F, feat.sharp_edges, corners=feat.corners)
+    got = hybridsub.LimitSurface(CUBE_V, CUBE_F, feature_angle=30)
+    smooth = hybridsub.LimitSurface(CUBE_V, CUBE_F)
+    assert np.array_equal(got.evaluate(FACES, BARY), want.evaluate(FACES, BARY))
+    assert not np.allclose(smooth.evaluate(FACES, BARY), want.evaluate(FACES, BARY))
+    L = hybridsub.limit_matrix(CUBE_F, feat.sharp_edges, corners=feat.corners, scheme="loop")
+    L2 = hybridsub.limit_matrix(CUBE_F, feature_angle=30, vertices=CUBE_V, scheme="loop")
+    assert abs(L - L2).max() == 0 and abs(L - hybridsub.limit_matrix(CUBE_F, scheme="loop")).max() > 0.01
+    assert np.allclose(L2 @ CUBE_V, hybridsub.limit_positions(CUBE_V, CUBE_F, scheme="loop", feature_angle=30))
+    with pytest.raises(TypeError, match="needs vertices="):
+        hybridsub.limit_matrix(CUBE_F, feature_angle=30)
+
+
+def test_limit_surface_takes_non_manifold_cut_and_max_memory():
+    """Two tetrahedra on one edge (four faces there): refused as before by default; cut, the
+    surface is the cut mesh's, with faces, rows and data over the caller's vertices."""
+    Vn = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 0.3, 1], [0.5, -1, 0.1], [0.5, -0.3, -1.0]])
+    Fn = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 4], [0, 5, 1], [0, 4, 5], [1, 5, 4]])
+    with pytest.raises(MeshError, match="not edge-manifold"):
+        hybridsub.LimitSurface(Vn, Fn)
+    s = hybridsub.LimitSurface(Vn, Fn, non_manifold="cut")
+    assert s.faces.shape == Fn.shape and np.array_equal(s.faces, Fn) and s.vertices.shape == Vn.shape
+    faces, bary = [0, 4, 7], [[1 / 3, 1 / 3, 1 / 3], [0.2, 0.3, 0.5], [0.5, 0.5, 0.0]]
+    M = s.evaluation_matrix(faces, bary)
+    assert M.shape == (3, 6) and np.allclose(M.sum(axis=1), 1)
+    assert np.allclose(M @ Vn, s.evaluate(faces, bary), atol=1e-14)
+    # the oracle: the cut mesh written out by hand (tetrahedron B on its own copies of 0 and 1, which the
+    # cut makes corners so that they move alike), evaluated as an ordinary manifold mesh
+    Vc = np.vstack([Vn, Vn[[0, 1]]])
+    Fc = Fn.copy()
+    Fc[4:] = np.where(Fc[4:] == 0, 6, np.where(Fc[4:] == 1, 7, Fc[4:]))
+    cut_by_hand = hybridsub.LimitSurface(Vc, Fc, corners=[0, 1, 6, 7])
+    assert np.allclose(cut_by_hand.evaluate(faces, bary), s.evaluate(faces, bary), atol=1e-14)
+    P = s.evaluate(faces, bary) + 0.01 * s.normals(faces, bary)
+    f, b, Q, d = s.project(P[:2])
+    assert np.allclose(np.abs(d), 0.01, atol=1e-9)
+    # max_memory bounds what the surface refines for its closest-point seeds
+    with pytest.raises(hybridsub.OutputTooLargeError):
+        hybridsub.LimitSurface(CUBE_V, CUBE_F, max_memory=1000).project(CUBE_V[:1] * 1.1)
