@@ -203,3 +203,17 @@ def test_limit_surface_takes_non_manifold_cut_and_max_memory():
     # max_memory bounds what the surface refines for its closest-point seeds
     with pytest.raises(hybridsub.OutputTooLargeError):
         hybridsub.LimitSurface(CUBE_V, CUBE_F, max_memory=1000).project(CUBE_V[:1] * 1.1)
+
+
+def test_subdivide_mesh_merges_detected_features_as_subdivide_does():
+    """A caller's semi-sharp crease that the angle also detects keeps the caller's sharpness in
+    both (before, subdivide_mesh let the detected infinite sharpness win)."""
+    import trimesh
+
+    e = np.array([[0, 1]])  # a cube edge: detected at 30 degrees too
+    V2, F2 = hybridsub.subdivide(CUBE_V, CUBE_F, e, levels=1, sharpness=[0.5], feature_angle=30)
+    out = hybridsub.subdivide_mesh(trimesh.Trimesh(CUBE_V, CUBE_F, process=False), levels=1, sharp_edges=e,
+                                   sharpness=[0.5], feature_angle=30)
+    assert np.allclose(np.asarray(out.vertices), V2, atol=1e-14) and np.array_equal(np.asarray(out.faces), F2)
+    inf = hybridsub.subdivide(CUBE_V, CUBE_F, e, levels=1, sharpness=[np.inf], feature_angle=30)[0]
+    assert not np.allclose(inf, V2)  # the sharpness given matters
