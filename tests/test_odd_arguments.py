@@ -217,3 +217,16 @@ def test_subdivide_mesh_merges_detected_features_as_subdivide_does():
     assert np.allclose(np.asarray(out.vertices), V2, atol=1e-14) and np.array_equal(np.asarray(out.faces), F2)
     inf = hybridsub.subdivide(CUBE_V, CUBE_F, e, levels=1, sharpness=[np.inf], feature_angle=30)[0]
     assert not np.allclose(inf, V2)  # the sharpness given matters
+
+
+def test_subdivide_given_a_mesh_object_points_to_subdivide_mesh():
+    import trimesh
+
+    m = trimesh.Trimesh(CUBE_V, CUBE_F, process=False)
+    for call in (lambda: hybridsub.subdivide(m), lambda: hybridsub.subdivide(m, levels=2),
+                 lambda: hybridsub.LimitSurface(m, CUBE_F)):
+        with pytest.raises(TypeError, match=r"got a trimesh\.Trimesh.*subdivide_mesh\(mesh"):
+            call()
+    with pytest.raises(TypeError, match="needs the faces F"):
+        hybridsub.subdivide(m.vertices)
+    assert len(hybridsub.subdivide(m.vertices, m.faces)[1]) == 3 * len(CUBE_F)  # trimesh's arrays are arrays

@@ -49,7 +49,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
-def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
@@ -119,7 +119,9 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
     >>> V, F = hybridsub.load_example()
     >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, feature_angle=30)   # creases found and kept
     """
-    Vf, out_dtype = as_vertices(V, return_dtype=True)
+    Vf, out_dtype = as_vertices(V, return_dtype=True)  # (a mesh object: a TypeError naming subdivide_mesh)
+    if F is None:
+        raise TypeError("subdivide(V, F, ...) needs the faces F (an (m, 3) array of vertex indices)")
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
