@@ -344,3 +344,19 @@ def test_fuzzed_files_give_mesh_errors_or_valid_meshes(tmp_path, capfd):
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_fuzzed_files_long(tmp_path, seed):
     _fuzz(tmp_path, int(os.environ.get("HYBRIDSUB_FILE_FUZZ", "400")), seed)
+
+
+def test_tags_written_to_a_format_that_loses_them_are_reported(tmp_path):
+    """Medit's .mesh takes line cells but not their sharpness: written as triangles, and the tags
+    reported dropped (a UserWarning), where VTK and VTU keep them."""
+    V, F = read_off(os.path.join(DATA, "octahedron.off"))
+    kw = dict(sharp_edges=[[0, 1]], corners=[3], sharp_faces=[2])
+    with pytest.warns(UserWarning, match="cannot hold 1 crease, 1 corner, 1 sharp face"):
+        hybridsub.write_mesh(tmp_path / "t.mesh", V, F, **kw)
+    assert len(hybridsub.read_mesh(tmp_path / "t.mesh").faces) == len(F)
+    for ext in ("vtk", "vtu"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            hybridsub.write_mesh(tmp_path / f"t.{ext}", V, F, **kw)
+        m = hybridsub.read_mesh(tmp_path / f"t.{ext}")
+        assert m.sharp_edges.tolist() == [[0, 1]] and m.corners.tolist() == [3] and m.sharp_faces.tolist() == [2]

@@ -166,38 +166,54 @@ def _check_cells(path: str, mesh, n: int) -> None:
             raise MeshError(f"{path}: {block.type} cell {j} refers to point {i}, but there are only {n} ({valid})")
 
 
+#: The meshio formats that keep the tag cells and their cell data through a write and a read
+#: (checked for VTK and VTU in tests/test_damaged_files.py); every other meshio format is written
+#: as triangles alone, and the tags are reported dropped (Medit's .mesh, for one, writes the
+#: line cells but not their sharpness, so the creases would be lost without a word).
+TAGGED_FORMATS = (".vtk", ".vtu", ".xdmf", ".xmf")
+
+
 def write_meshio(path: str, m: TaggedMesh) -> str:
     """Write ``m`` through meshio; returns a description of the tags the format could not hold
-    ('' if none): a format without mixed cells or cell data gets the triangles alone."""
+    ('' if none): a format not in ``TAGGED_FORMATS`` gets the triangles alone."""
     import meshio
 
-    cells = [("triangle", m.faces)]
-    sharp = [np.zeros(len(m.faces))]
-    sf = np.zeros(len(m.faces), np.uint8)
-    sf[m.sharp_faces] = 1
-    marks = [sf]
-    if len(m.sharp_edges):
-        cells.append(("line", m.sharp_edges))
-        sharp.append(sharpness_to_file(m.sharpness))
-        marks.append(np.zeros(len(m.sharp_edges), np.uint8))
-    if len(m.corners):
-        cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
-        sharp.append(np.full(len(m.corners), INFINITE))
-        marks.append(np.zeros(len(m.corners), np.uint8))
     point_data = {}
     if m.vertex_colors is not None:
         point_data["colors"] = color_bytes(m.vertex_colors)
     if m.vertex_uv is not None:
         point_data["uv"] = m.vertex_uv
-    tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
-                         cell_data={"sharpness": sharp, "sharp_face": marks})
-    try:
-        tagged.write(path)
+    name = path.lower()
+    if m.has_tags and name.endswith(TAGGED_FORMATS):
+        cells = [("triangle", m.faces)]
+        sharp = [np.zeros(len(m.faces))]
+        sf = np.zeros(len(m.faces), np.uint8)
+        sf[m.sharp_faces] = 1
+        marks = [sf]
+        if len(m.sharp_edges):
+            cells.append(("line", m.sharp_edges))
+            sharp.append(sharpness_to_file(m.sharpness))
+            marks.append(np.zeros(len(m.sharp_edges), np.uint8))
+        if len(m.corners):
+            cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
+            sharp.append(np.full(len(m.corners), INFINITE))
+            marks.append(np.zeros(len(m.corners), np.uint8))
+        tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
+                             cell_data={"sharpness": sharp, "sharp_face": marks})
+        _meshio_write(path, tagged)
         return ""
-    except Exception:  # the format cannot hold lines, vertices or cell data: triangles alone
-        pass
     try:
-        meshio.Mesh(m.vertices, [("triangle", m.faces)]).write(path)
+        _meshio_write(path, meshio.Mesh(m.vertices, [("triangle", m.faces)], point_data=point_data))
+    except MeshError:
+        if not point_data:
+            raise
+        _meshio_write(path, meshio.Mesh(m.vertices, [("triangle", m.faces)]))  # a format without point data
+    return describe_tags(m)
+
+
+def _meshio_write(path: str, mesh) -> None:
+    try:
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            mesh.write(path)
     except Exception as e:
         raise MeshError(f"{path}: meshio could not write it: {type(e).__name__}: {e}") from None
-    return describe_tags(m)
