@@ -230,3 +230,44 @@ def test_subdivide_given_a_mesh_object_points_to_subdivide_mesh():
     with pytest.raises(TypeError, match="needs the faces F"):
         hybridsub.subdivide(m.vertices)
     assert len(hybridsub.subdivide(m.vertices, m.faces)[1]) == 3 * len(CUBE_F)  # trimesh's arrays are arrays
+
+
+# ----------------------------------------------------------------------------------------------
+# the command line
+
+NM_V = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 0.3, 1], [0.5, -1, 0.1], [0.5, -0.3, -1.0]])
+NM_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 4], [0, 5, 1], [0, 4, 5], [1, 5, 4]])
+
+
+def test_cli_refuses_an_output_format_before_the_work(tmp_path, capsys):
+    from hybridsub._app.cli import main
+
+    src = os.path.join(DATA, "tetrahedron.off")
+    for out in ("out.xyz", "out.svg", "out.nosuch"):
+        assert main(["subdivide", src, "-o", str(tmp_path / out)]) == 1
+        err = capsys.readouterr().err
+        assert f"{tmp_path / out}: cannot write a mesh in this format" in err
+        assert "faces" not in err.split("error:")[0]  # nothing was refined first
+    assert main(["fit", src, src, "-o", str(tmp_path / "fit.xyz"), "--levels", "1"]) == 1
+    assert "cannot write a mesh" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_cli_non_manifold_cut(tmp_path, capsys):
+    from hybridsub._app.cli import main
+
+    hybridsub.write_mesh(tmp_path / "nm.obj", NM_V, NM_F)
+    assert main(["subdivide", str(tmp_path / "nm.obj"), "-o", str(tmp_path / "a.obj"), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert "--non-manifold cut" in err and 'non_manifold="cut"' not in err
+    assert main(["subdivide", str(tmp_path / "nm.obj"), "-o", str(tmp_path / "a.obj"), "--levels", "2",
+                 "--non-manifold", "cut", "-q"]) == 0
+    got = hybridsub.read_mesh(tmp_path / "a.obj")
+    V2, F2 = hybridsub.subdivide(NM_V, NM_F, levels=2, non_manifold="cut")
+    assert np.array_equal(got.faces, F2) and np.abs(got.vertices - V2).max() < 1e-12
+    # the cut's corners are written with the result, so one more level of it is two levels of the input
+    assert main(["subdivide", str(tmp_path / "nm.obj"), "-o", str(tmp_path / "b.obj"), "--non-manifold", "cut",
+                 "-q"]) == 0
+    assert main(["subdivide", str(tmp_path / "b.obj"), "-o", str(tmp_path / "c.obj"), "-q"]) == 0
+    again = hybridsub.read_mesh(tmp_path / "c.obj")
+    assert np.array_equal(again.faces, F2) and np.abs(again.vertices - V2).max() < 1e-12
