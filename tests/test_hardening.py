@@ -102,7 +102,7 @@ def test_failed_write_leaves_nothing_and_keeps_the_old_file(tmp_path, monkeypatc
 def test_unwritable_format_leaves_no_file(tmp_path, capsys):
     out = str(tmp_path / "x.xyz")
     msg = one_line_error(capsys, ["subdivide", os.path.join(DATA, "tetrahedron.off"), "-o", out, "-q"], out)
-    assert f"{out}: trimesh could not write it" in msg and ".partial" not in msg
+    assert f"{out}: cannot write a mesh in this format (trimesh could not write it" in msg and ".partial" not in msg
     assert os.listdir(tmp_path) == []
 
 

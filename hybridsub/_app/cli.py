@@ -43,6 +43,7 @@ def cmd_subdivide(a) -> int:
 
     if not os.path.splitext(a.output)[1]:
         raise PipelineError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .npz, .stl, .glb, …)")
+    _writable(a.output, binary=not a.ascii)
     subdivide_file(_file_options(a), a.input, a.output)
     return 0
 
@@ -381,6 +382,9 @@ def _add_subdivide(sub) -> None:
     s.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
     _tag_options(s)
     _uv_option(s)
+    s.add_argument("--non-manifold", choices=("raise", "cut"), default="raise", dest="non_manifold",
+                   help="edges in three or more faces, or inconsistently oriented: refuse (raise, the default) or cut "
+                        "the mesh along them (cut; the pieces meet at creases)")
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
     s.add_argument("--ascii", action="store_true", help="PLY output in ASCII instead of binary")
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")
@@ -473,9 +477,17 @@ def _add_demo(sub) -> None:
 # fit and decompose (issue 15): the work is in _app/fit_command.py
 
 
+def _writable(path: str, binary: bool = True) -> None:
+    """Refuse an output format that cannot hold a mesh (``-o out.xyz``) before the work, not after."""
+    from .. import _io
+
+    _io.check_writable(path, binary=binary)
+
+
 def cmd_fit(a) -> int:
     from .fit_command import fit_file
 
+    _writable(a.output)
     return fit_file(a.control, a.target, a.output, levels=a.levels, scheme=a.scheme, smoothness=a.smoothness,
                     max_iterations=a.max_iterations, tol=a.tol, quiet=a.quiet)
 
@@ -483,6 +495,7 @@ def cmd_fit(a) -> int:
 def cmd_decompose(a) -> int:
     from .fit_command import decompose_file
 
+    _writable(a.output)
     return decompose_file(a.coarse, a.fine, a.output, levels=a.levels, scheme=a.scheme, quiet=a.quiet)
 
 

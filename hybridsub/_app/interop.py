@@ -9,7 +9,7 @@ import numpy as np
 from .. import _input as val
 from .._io import METADATA_KEY, classes, kind_of
 from .._errors import MeshError
-from .._input import detect_features, merge_edges
+from .._input import detect_features, merge_detected, merge_edges
 from .._refiner import Refinement, refine
 from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
 
@@ -70,8 +70,9 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
     sharp_edges, sharpness, sharp_faces, corners
         As for :func:`hybridsub.subdivide`, in ``mesh``'s vertex and face indices.
     feature_angle : float, optional
-        Also tag every edge whose dihedral angle exceeds this many degrees as a crease, and
-        vertices with three or more creases as corners.
+        Also tag what :func:`hybridsub.detect_features` finds at this dihedral angle (degrees),
+        by the rule of :func:`hybridsub.subdivide`: its sharp edges (infinitely sharp, unless
+        given in ``sharp_edges``, whose sharpness then wins) and corners.
     loop_weights : {"loop", "warren"}
     weld : bool, optional
         Merge vertices at exactly equal positions (bit for bit, as exporters write both
@@ -195,7 +196,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
 
 def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angle):
     """The caller's tags in the welded vertex numbers, and the features detected on the welded
-    mesh merged in (the largest sharpness wins); None where there are none."""
+    mesh merged in by the gate's rule (:func:`merge_detected`: the caller's sharpness wins, as
+    in :func:`hybridsub.subdivide`); None where there are none."""
     edges_w: np.ndarray | None = None
     sharp_w: np.ndarray | None = None
     corners_w: np.ndarray | None = None
@@ -213,13 +215,15 @@ def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angl
         corners_w = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
     if feature_angle is not None:
         feat = detect_features(w.V, w.F, feature_angle)
+        nw = len(w.V)
         if edges_w is None:
-            edges_w, sharp_w = feat.sharp_edges, None
-        else:
-            edges_w, sharp_w = merge_edges(np.vstack([edges_w, feat.sharp_edges]),
-                                           np.concatenate([sharp_w, np.full(len(feat.sharp_edges), np.inf)]),
-                                           len(w.V))
-        corners_w = feat.corners if corners_w is None else np.union1d(corners_w, feat.corners)
+            edges_w, sharp_w = np.empty((0, 2), np.int64), np.empty(0)
+        else:  # copies of one edge welded into one: the caller's own tags, the largest kept
+            edges_w, sharp_w = merge_edges(edges_w, sharp_w, nw)
+        mask = np.zeros(nw, bool)
+        mask[np.empty(0, np.int64) if corners_w is None else corners_w] = True
+        edges_w, sharp_w, mask = merge_detected(feat, edges_w, sharp_w, mask, nw)
+        corners_w = np.flatnonzero(mask)
     return edges_w, sharp_w, corners_w
 
 

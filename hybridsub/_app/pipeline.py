@@ -52,6 +52,8 @@ class FileOptions:
     ignore_tags, triangulate, weld, no_tags, ascii
         ``--ignore-tags`` (tags stored in the input), ``--triangulate``, ``--weld`` (on
         reading), ``--no-tags``, ``--ascii`` (on writing).
+    non_manifold : {"raise", "cut"}
+        ``--non-manifold``: as :func:`hybridsub.subdivide`'s ``non_manifold``.
     force : bool
         Run even if the memory estimate exceeds the memory at hand (and lift the library's limit).
     quiet : bool
@@ -78,6 +80,7 @@ class FileOptions:
     ignore_tags: bool = False
     triangulate: bool = False
     weld: bool = False
+    non_manifold: str = "raise"
     no_tags: bool = False
     ascii: bool = False
     force: bool = False
@@ -385,9 +388,10 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
     try:
         res = refine_by_level(X, mesh.faces, levels, scheme=scheme, loop_weights=opts.loop_weights,
                               on_level=bar.update, max_memory="none" if opts.force else None, **uv_args,
-                              **feat.tags())
-    except MeshError as e:
-        raise PipelineError(f"{path}: {e}") from None
+                              non_manifold=opts.non_manifold, **feat.tags())
+    except MeshError as e:  # the library's advice in the command line's words
+        raise PipelineError(f"{path}: " + str(e).replace('pass non_manifold="cut"', "pass --non-manifold cut")
+                            .replace('with non_manifold="cut"', "with --non-manifold cut")) from None
     except OutputTooLargeError as e:  # the library's memory limit (HYBRIDSUB_MAX_MEMORY); --force lifts it
         raise PipelineError(f"{path}: {e}, or pass --force") from None
     except MemoryError:

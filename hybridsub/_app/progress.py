@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._input import open_gate
 from .._refiner import subdivide_face_varying_levels, subdivide_levels
 from .._units import si
 
@@ -35,7 +36,7 @@ class LevelResult:
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
                     corners=None, loop_weights="loop", on_level=None, max_memory=None, uv=None, face_uv=None,
-                    uv_mode="linear") -> LevelResult:
+                    uv_mode="linear", non_manifold="raise") -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
@@ -44,13 +45,14 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     :func:`hybridsub.subdivide_face_varying`.
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
+    F = F0 = np.asarray(F, dtype=np.int64)
+    n0 = len(X)
     parent = np.arange(len(F), dtype=np.int64)
     pairs, sharp = sharp_edges, sharpness
     mask = None
     total = 0.0
     tags = dict(sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                max_memory=max_memory)
+                max_memory=max_memory, non_manifold=non_manifold)
     if uv is not None:
         uv = np.ascontiguousarray(uv, dtype=np.float64)
         face_uv = np.asarray(face_uv, dtype=np.int64)
@@ -78,6 +80,10 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     if sharp is None:
         sharp = np.full(len(pairs), np.inf)
     corners = np.empty(0, np.int64) if corners is None else np.asarray(corners, dtype=np.int64)
+    if non_manifold == "cut" and levels:  # the cut's copies are corners too (input vertices keep their numbers)
+        inp = open_gate(F0, sharp_edges, 0, n_vertices=n0, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
+                        corners=corners, loop_weights=loop_weights, non_manifold="cut")
+        corners = np.flatnonzero(inp.corner)
     return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total, uv,
                        face_uv)
 

@@ -102,7 +102,7 @@ def run_task(job: dict) -> dict:
             rec["no_space"] = True
     except MemoryError:
         rec["error"] = f"{src}: out of memory; use fewer levels"
-    except Exception as e:  # a bug: recorded with its traceback, the batch goes on
+    except (Exception, SystemExit) as e:  # a bug (or a library's sys.exit): recorded, the worker and the batch go on
         rec["error"] = f"{src}: internal error: {type(e).__name__}: {e}"
         rec["traceback"] = traceback.format_exc()
     finally:

@@ -21,13 +21,14 @@ gradients, and refactored only when they stall.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
 from .._errors import MeshError
-from .._input import as_vertices
+from .._input import as_faces, as_vertices, count_of, open_gate
 from .._typing import ArrayLike, LoopWeights, Scheme
 from ._closest_kernels import face_systems
 from .closest import ClosestPoints
@@ -259,7 +260,8 @@ def _unit(N: np.ndarray, residual: np.ndarray) -> np.ndarray:
 def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *, scheme: Scheme = "hybrid",
         sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
         V0: ArrayLike | None = None, levels: int | None = None, smoothness: float = 0.0, max_iterations: int = 50,
-        tol: float = 1e-12, loop_weights: LoopWeights = "loop", callback=None) -> FitResult:
+        tol: float = 1e-12, loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
+        callback=None) -> FitResult:
     """Control positions whose subdivision surface is closest to target points.
 
     Alternates the closest points of the targets on the current surface and a sparse
@@ -278,10 +280,10 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
         The control mesh's tags and rules, as in :func:`hybridsub.refine`.
     V0 : (n, 3) array_like of float, optional
-        Starting control positions, usually the control mesh's own (``fit(F, P, V0=V)``).
-        Default: the first n target points (the control mesh is assumed to be made on the
-        target's own samples, its vertex i at ``points[i]``, roughly over the target; no
-        registration is made).
+        Starting control positions, usually the control mesh's own (``fit(F, P, V0=V)``);
+        vertices no face uses are allowed and stay where they are. Default: the first n target
+        points (the control mesh is assumed to be made on the target's own samples, its vertex
+        i at ``points[i]``, roughly over the target; no registration is made).
     levels : int, optional
         Fit the level-``levels`` refined mesh (piecewise linear, exact closest points, fast);
         default None fits the limit surface (:class:`hybridsub.LimitSurface`: its ``project``
@@ -294,6 +296,10 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     tol : float
         Stop when the largest vertex move of an update is below ``tol`` × the targets'
         bounding-box diagonal, or the squared error decreases by less than ``tol`` relatively.
+    feature_angle : float, optional
+        Also keep sharp the edges whose dihedral angle at the start positions exceeds this
+        many degrees, with their corners (:func:`hybridsub.detect_features`), as for
+        :func:`hybridsub.subdivide`.
     callback : callable, optional
         Called after each projection as ``callback(iteration, rms, max_error)``.
 
@@ -302,11 +308,27 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     FitResult
         ``vertices``, ``rms``, ``max_error``, ``iterations``, ``converged``, ``history``.
 
+    Raises
+    ------
+    MeshError
+        No faces; a start ``V0`` whose triangles all have zero area; coordinates too far apart
+        to be fitted in double precision.
+    ValueError, TypeError
+        An option out of range or of the wrong type (the message names it).
+
+    Warns
+    -----
+    UserWarning
+        Fewer points than unknowns (three per control vertex) without ``smoothness``: the fit
+        is underdetermined, and many control meshes fit the points as well as the one returned.
+
     Notes
     -----
     The tangential damping λ is RMS / diagonal clamped to [1e-6, 1e-2] (firm far from the
     target, vanishing near it), and an update that raises the error is halved (up to 30
-    times) before the next, so far starts converge too, more slowly.
+    times) before the next, so far starts converge too, more slowly. The fit runs on the
+    points and start moved to the origin and scaled to a unit box (the energy is quadratic in
+    lengths, so the answer is the same), which keeps coordinates of 1e200 or 1e-200 in range.
 
     Examples
     --------
@@ -321,25 +343,82 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
     (True, True)
     """
     pts = as_points(points)
-    r = refine(F, sharp_edges, 0 if levels is None else levels, scheme=scheme, sharpness=sharpness,
-               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+    max_iterations, tol, smoothness = _check_numbers(max_iterations, tol, smoothness)
+    n_given = None
+    if V0 is not None:
+        n_given, n_used = len(as_vertices(V0)), as_faces(F, None)[1]
+        if n_given < n_used:
+            raise MeshError(f"V0 must have one row per control vertex (at least {n_used}, the faces use vertex "
+                            f"{n_used - 1}), got shape {np.shape(as_vertices(V0))}")
+    tags = dict(scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
+                loop_weights=loop_weights)
+    r = refine(F, sharp_edges, 0 if levels is None else levels, n_vertices=n_given, **tags)
+    if len(r.faces) == 0:
+        raise MeshError("F has no faces: there is no surface to fit")
     n = r.n_coarse
     V = _start(V0, pts, n)
-    max_iterations, tol, smoothness = _check_numbers(max_iterations, tol, smoothness)
+    if feature_angle is not None:  # the features of the start, merged into the tags as subdivide does
+        inp = open_gate(F, sharp_edges, 0, n_vertices=n, positions=V, feature_angle=feature_angle, **tags)
+        sharp_edges, tags["sharpness"] = inp.sharp_edges, inp.sharpness
+        tags["corners"] = np.flatnonzero(inp.corner)
+        r = refine(F, sharp_edges, 0 if levels is None else levels, n_vertices=n, **tags)
+    centre, scale = _normalisation(pts, V)
+    pts, V = (pts - centre) / scale, (V - centre) / scale
+    _check_start(r, V, len(pts), n, smoothness)
     if levels is None:
-        surface = LimitFitSurface(LimitSurface(V, F, sharp_edges, scheme=scheme, sharpness=sharpness,
-                                               sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights))
+        surface = LimitFitSurface(LimitSurface(V, F, sharp_edges, **tags))
     else:
         surface = LevelSurface(r, pts)
     smooth = None
     if smoothness > 0:
-        r0 = r if levels == 0 else refine(F, sharp_edges, 0, scheme=scheme, sharpness=sharpness,
-                                           sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+        r0 = r if levels == 0 else refine(F, sharp_edges, 0, n_vertices=n, **tags)
         corner = np.zeros(n, dtype=bool)
         corner[r0.corners] = True
         Lu = umbrella(r0.faces, n, np.asarray(r0.sharp_edges).reshape(-1, 2), corner)
         smooth = (smoothness / n) * sp.csr_matrix(Lu.T @ Lu)
-    return _iterate(surface, V, pts, smooth, max_iterations, tol, callback)
+    user = None if callback is None else (lambda i, rms, mx: callback(i, rms * scale, mx * scale))
+    res = _iterate(surface, V, pts, smooth, max_iterations, tol, user)
+    hist = res.history.copy()
+    for k in ("rms", "max_error", "step"):
+        hist[k] *= scale
+    return FitResult(res.vertices * scale + centre, res.rms * scale, res.max_error * scale, res.iterations,
+                     res.converged, hist)
+
+
+def _normalisation(pts: np.ndarray, V: np.ndarray) -> tuple[np.ndarray, float]:
+    """Centre and scale that move the points' bounding box to the origin and a unit size:
+    computed without squares or sums, so 1e300 stays finite; MeshError where the points (or
+    the start) span more than a double can hold."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    centre = lo / 2 + hi / 2
+    with np.errstate(over="ignore"):
+        extent = float(np.max(hi - lo))
+    if not np.isfinite(extent):
+        raise MeshError("the points span more than a double can hold (their bounding box overflows): "
+                        "scale them down")
+    scale = extent if extent > 0 else max(float(np.abs(centre).max()), 1.0)
+    with np.errstate(over="ignore"):
+        far = float(np.abs((V - centre) / scale).max())
+    if not far < 1e150:
+        raise MeshError(f"V0 lies {far:.3g} times the points' size away from them: too far to be fitted in "
+                        "double precision; start from positions near the points")
+    return centre, scale
+
+
+def _check_start(r, V: np.ndarray, m: int, n: int, smoothness: float) -> None:
+    """MeshError for a start with no area (every triangle degenerate: nothing to project on);
+    a warning for fewer points than unknowns."""
+    tri = (r.matrix @ V)[r.faces]
+    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    if not (area > 0).any():
+        raise MeshError("V0 has no area: every triangle of the start is degenerate (all vertices at one point, or "
+                        "on one line), so the points have nothing to be projected on; start from the control mesh's "
+                        "own positions")
+    used = int((np.diff(sp.csc_matrix(r.matrix).indptr) > 0).sum())
+    if smoothness == 0 and m < 3 * used:
+        warnings.warn(f"fit: {count_of(m, 'point')} for {3 * used:,} unknowns ({count_of(used, 'control vertex')} "
+                      "× 3): the fit is underdetermined, and many control meshes fit the points as well as this "
+                      "one; give more points, or smoothness > 0", UserWarning, stacklevel=3)
 
 
 def _iterate(surface, V, pts, smooth, max_iterations, tol, callback) -> FitResult:
@@ -402,12 +481,23 @@ def _start(V0, pts: np.ndarray, n: int) -> np.ndarray:
     return V.copy()
 
 
+#: The largest smoothness: beyond, the points' term is below the rounding of the fairness term.
+MAX_SMOOTHNESS = 1e12
+
+
 def _check_numbers(max_iterations, tol, smoothness):
-    if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations or max_iterations < 0:
+    for name, x in (("max_iterations", max_iterations), ("tol", tol), ("smoothness", smoothness)):
+        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+            raise TypeError(f"{name} must be a number, got {x!r}")
+    if not (np.isfinite(max_iterations) and int(max_iterations) == max_iterations and max_iterations >= 0):
         raise ValueError(f"max_iterations must be a non-negative integer, got {max_iterations!r}")
+    max_iterations = int(max_iterations)
     tol, smoothness = float(tol), float(smoothness)
     if not tol >= 0:
         raise ValueError(f"tol must be >= 0, got {tol}")
     if not (smoothness >= 0 and np.isfinite(smoothness)):
         raise ValueError(f"smoothness must be a finite number >= 0, got {smoothness}")
-    return int(max_iterations), tol, smoothness
+    if smoothness > MAX_SMOOTHNESS:
+        raise ValueError(f"smoothness {smoothness:g} is more than {MAX_SMOOTHNESS:g}: the points' distances would be "
+                         "lost in the rounding of the fairness term, and the fit would ignore them")
+    return max_iterations, tol, smoothness

@@ -16,6 +16,7 @@ the vertex's first face), so it turns with the mesh.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +39,10 @@ class MultiresDetails:
         True when the details are in local frames (three-column data, ``frames=True``).
     shape : tuple of int
         Shape of one row of the data (``X.shape[1:]``), restored by ``reconstruct``.
+    fingerprint : str
+        A hash of the refinement that made them (every step's faces and matrix, so its
+        connectivity, scheme, weights and tags): ``reconstruct`` refuses details whose
+        fingerprint is not its own refinement's ('' skips the check, for details made by hand).
 
     A ``MultiresDetails`` is a sequence of its levels: ``len(d)``, ``d[k]``, iteration.
     """
@@ -45,6 +50,7 @@ class MultiresDetails:
     levels: tuple
     local_frames: bool
     shape: tuple
+    fingerprint: str = ""
 
     def __len__(self) -> int:
         return len(self.levels)
@@ -74,15 +80,37 @@ def decompose(steps, n_coarse: int, cache: dict, X, frames: bool | None) -> tupl
             d = np.einsum("vij,vj->vi", local_frames(refined, st.faces), d)
         levels.append(d)
         Y = c
-    return Y.reshape((n_coarse,) + shape), MultiresDetails(tuple(reversed(levels)), local, shape)
+    return Y.reshape((n_coarse,) + shape), MultiresDetails(tuple(reversed(levels)), local, shape,
+                                                            fingerprint(steps, n_coarse, cache))
 
 
-def reconstruct(steps, n_coarse: int, coarse, details: MultiresDetails) -> np.ndarray:
+def fingerprint(steps, n_coarse: int, cache: dict | None = None) -> str:
+    """A hash of a refinement: its coarse vertex count and every step's faces and matrix
+    (pattern and weights), which its scheme, weights and tags determine (kept in ``cache``)."""
+    if cache is not None and "fingerprint" in cache:
+        return cache["fingerprint"]
+    h = hashlib.blake2b(digest_size=16)
+    h.update(np.int64(n_coarse).tobytes())
+    for st in steps:
+        S = sp.csr_matrix(st.matrix)
+        for a in (np.asarray(S.shape, np.int64), S.indptr.astype(np.int64), S.indices.astype(np.int64),
+                  S.data.astype(np.float64), np.ascontiguousarray(st.faces, dtype=np.int64)):
+            h.update(np.ascontiguousarray(a).tobytes())
+    out = h.hexdigest()
+    if cache is not None:
+        cache["fingerprint"] = out
+    return out
+
+
+def reconstruct(steps, n_coarse: int, coarse, details: MultiresDetails, cache: dict | None = None) -> np.ndarray:
     """Finest-level data from coarse data and details (see :meth:`Refinement.reconstruct`)."""
     if not isinstance(details, MultiresDetails):
         raise TypeError(f"details must be the MultiresDetails that decompose returned, got {type(details).__name__}")
     if len(details) != len(steps):
         raise ValueError(f"details have {len(details)} levels, the refinement {len(steps)} steps")
+    if details.fingerprint and details.fingerprint != fingerprint(steps, n_coarse, cache):
+        raise ValueError("details were made by another refinement (other faces, vertex numbering, scheme, weights "
+                         "or tags): reconstruct with the Refinement whose decompose made them")
     Y, shape = _as_rows(coarse, n_coarse, "coarse")
     if shape != details.shape:
         raise ValueError(f"coarse rows have shape {shape}, the details were made from rows of shape {details.shape}")
@@ -90,6 +118,10 @@ def reconstruct(steps, n_coarse: int, coarse, details: MultiresDetails) -> np.nd
         d = details[k]
         if d.shape != (st.n_vertices, Y.shape[1]):
             raise ValueError(f"details[{k}] must have shape {(st.n_vertices, Y.shape[1])}, got {d.shape}")
+        bad = ~np.isfinite(d).all(axis=1)
+        if bad.any():
+            raise ValueError(f"details[{k}] must be finite; row {int(np.flatnonzero(bad)[0])} is not "
+                             f"({int(bad.sum()):,} such rows)")
         refined = st.matrix @ Y
         if details.local_frames:
             d = np.einsum("vij,vi->vj", local_frames(refined, st.faces), d)
@@ -115,6 +147,7 @@ def local_frames(P: np.ndarray, faces: np.ndarray) -> np.ndarray:
     R[:] = np.eye(3)
     if len(faces) == 0:
         return R
+    P = _unit_box(P)  # frames do not change with scale or translation; products of 1e200 would overflow
     fn = np.cross(P[faces[:, 1]] - P[faces[:, 0]], P[faces[:, 2]] - P[faces[:, 0]])
     N = np.zeros((n, 3))
     for i in range(3):
@@ -141,6 +174,16 @@ def local_frames(P: np.ndarray, faces: np.ndarray) -> np.ndarray:
     R[v, 1] = np.cross(nrm, t)
     R[v, 2] = nrm
     return R
+
+
+def _unit_box(P: np.ndarray) -> np.ndarray:
+    """``P`` moved and scaled into the unit box (its largest extent 1), without squares."""
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    with np.errstate(over="ignore"):
+        extent = float(np.max(hi - lo))
+    if not np.isfinite(extent):
+        raise ValueError("positions span more than a double can hold (their bounding box overflows)")
+    return (P - (lo / 2 + hi / 2)) / extent if extent > 0 else P - lo
 
 
 def _solve(cache: dict, k: int, S: sp.csr_matrix, Y: np.ndarray) -> np.ndarray:

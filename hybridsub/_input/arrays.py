@@ -109,11 +109,25 @@ def writable(A: np.ndarray) -> np.ndarray:
     return A if A.flags.writeable else A.copy()
 
 
+def mesh_object(x) -> str | None:
+    """The class name of a trimesh or pyvista mesh object (``"trimesh.Trimesh"``), else None:
+    what the array functions are given by mistake, and then point to ``subdivide_mesh``."""
+    if isinstance(x, np.ndarray):  # trimesh's TrackedArray is an array
+        return None
+    top = type(x).__module__.split(".")[0]
+    return f"{top}.{type(x).__name__}" if top in ("trimesh", "pyvista") else None
+
+
 def as_vertices(V, return_dtype: bool = False):
     """(n, 3) float64 C-contiguous copy-or-view of V (never written to).
 
     With ``return_dtype``, also the dtype results should take: V's if floating, else float64.
     """
+    kind = mesh_object(V)
+    if kind is not None:
+        raise TypeError(f"V must be an (n, 3) array of positions, got a {kind}: pass its vertices and faces, or "
+                        "refine the mesh object with hybridsub.subdivide_mesh(mesh, ...), which keeps its UVs, "
+                        "colours and tags")
     A = as_array(V, "V", 3, "vertex", "n")
     if A.ndim == 1 and A.size == 0:
         A = A.reshape(0, 3)

@@ -2,7 +2,7 @@
 lists. Other layers import from here, never from the modules inside.
 
 mesh.py           TaggedMesh, as_tagged, describe_tags, the tag conventions of files
-formats.py        read_mesh / write_mesh / write: the format by the file's extension
+formats.py        read_mesh / write_mesh / write / check_writable: the format by the file's extension
 obj.py, ply.py, off.py, npz.py, trimesh_formats.py, meshio_formats.py: one module per
                   format or library (off.py also read_off, the examples' plain loader)
 convert.py        trimesh.Trimesh and pyvista.PolyData as TaggedMesh (write_mesh(path, mesh))
@@ -13,13 +13,13 @@ examples.py       the shipped example meshes (example_path, load_example)
 """
 
 from .examples import example_path, load_example
-from .formats import read_mesh, write, write_mesh
+from .formats import check_writable, read_mesh, write, write_mesh
 from .convert import TAG_NAMES, kind_of, triangles_of
 from .mesh import METADATA_KEY, TaggedMesh, describe_tags
 from .off import read_off
 from .tagfiles import read_edge_file, read_list_file
 from .weld import classes, weld
 
-__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "classes", "kind_of", "triangles_of",
+__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "check_writable", "classes", "kind_of", "triangles_of",
            "describe_tags", "example_path", "load_example", "read_edge_file",
            "read_list_file", "read_mesh", "read_off", "weld", "write", "write_mesh"]

@@ -19,6 +19,7 @@ import warnings
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from .._errors import MeshError
@@ -79,20 +80,31 @@ def read_mesh(path: str | os.PathLike, *, triangulate: bool = False) -> TaggedMe
     if os.path.isdir(path):
         raise MeshError(f"{path}: is a directory, not a mesh file")
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".obj":
-        mesh = read_obj(path, triangulate)
-    elif ext == ".ply":
-        mesh = read_ply_mesh(path, triangulate)
-    elif ext == ".off":
-        mesh = read_off_mesh(path, triangulate)
-    elif ext == ".npz":
-        mesh = read_npz(path)
-    elif _through_meshio(path):
-        mesh = read_meshio(path, triangulate)
-    else:
-        mesh = read_trimesh(path, ext)
+    try:
+        mesh = _read_format(path, ext, triangulate)
+    except (MeshError, OSError, ImportError):
+        raise
+    except MemoryError:
+        raise MeshError(f"{path}: not enough memory to read it ({os.path.getsize(path):,} bytes)") from None
+    except Exception as e:  # a damaged file the reader's own checks missed: still one error naming the file
+        raise MeshError(f"{path}: cannot be read as {ext.lstrip('.').upper() or 'a mesh'}: the file is damaged "
+                        f"({type(e).__name__}: {e})") from None
     return check_read(path, mesh)
 
+
+def _read_format(path: str, ext: str, triangulate: bool) -> TaggedMesh:
+    """The reader of ``ext``'s format applied to ``path``."""
+    if ext == ".obj":
+        return read_obj(path, triangulate)
+    if ext == ".ply":
+        return read_ply_mesh(path, triangulate)
+    if ext == ".off":
+        return read_off_mesh(path, triangulate)
+    if ext == ".npz":
+        return read_npz(path)
+    if _through_meshio(path):
+        return read_meshio(path, triangulate)
+    return read_trimesh(path, ext)
 
 
 def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayLike | None = None, *,
@@ -181,6 +193,39 @@ def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vert
     checked = as_tagged(m.vertices, m.faces, **tags)
     return replace(m, sharp_edges=checked.sharp_edges, sharpness=checked.sharpness, corners=checked.corners,
                    sharp_faces=checked.sharp_faces)
+
+
+def check_writable(path: str, *, binary: bool = True) -> None:
+    """MeshError naming ``path`` if a mesh cannot be written in its format (an unknown extension,
+    a format of points or of flat drawings, a missing optional module): found by writing a
+    small tetrahedron under the same extension in a temporary folder, so that a command can
+    refuse before the work rather than after it.
+
+    >>> check_writable("out.xyz")
+    Traceback (most recent call last):
+    ...
+    hybridsub._errors.MeshError: out.xyz: cannot write a mesh in this format (trimesh could not write it: ValueError: object must be PointCloud)
+    """
+    import tempfile
+
+    tet = TaggedMesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]),
+                     np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]))
+    with tempfile.TemporaryDirectory() as d:
+        try:
+            _write_format(os.path.join(d, "probe" + _full_ext(path)), tet, os.path.splitext(path)[1].lower(), binary, d)
+        except MeshError as e:
+            reason = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
+            raise MeshError(f"{path}: cannot write a mesh in this format ({reason})") from None
+        except OSError:  # the temporary folder's trouble, not the format's: the real write will say
+            return
+        except (ImportError, ValueError, TypeError) as e:
+            raise MeshError(f"{path}: cannot write a mesh in this format ({type(e).__name__}: {e})") from None
+
+
+def _full_ext(path: str) -> str:
+    """The extension with a compression suffix kept (``.vol.gz``), as the writers choose by."""
+    ext = _meshio_ext(path)
+    return ext if ext.endswith(".gz") else os.path.splitext(path)[1]
 
 
 def write(path: str, mesh: TaggedMesh, *, binary: bool = True, folder: str | None = None) -> str:

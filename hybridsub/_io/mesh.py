@@ -214,16 +214,26 @@ def _material(m: TaggedMesh):
 
 
 def check_read(path: str, mesh: TaggedMesh) -> TaggedMesh:
-    """``mesh`` as read from ``path`` by any reader, checked where every format can go wrong
-    alike: faces present, three finite coordinates per vertex.
+    """``mesh`` as read from ``path`` by any reader, checked once where every format can go wrong
+    alike: faces present, three finite coordinates per vertex, every index in range (faces, tags,
+    UVs), the counts that belong together equal (one sharpness per crease, one colour per vertex,
+    one UV triple per face), every number finite where it must be. Every reader's output comes
+    through here, so a damaged file that a reader let through is refused with the file's name.
 
     >>> check_read("t.off", TaggedMesh(np.array([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]]), np.array([[0, 1, 2]])))
     Traceback (most recent call last):
     ...
     hybridsub._errors.MeshError: t.off: vertex 1 has a non-finite coordinate (nan): every coordinate must be a finite number
+    >>> check_read("t.vtk", TaggedMesh(np.eye(3), np.array([[0, 1, 999999999999]])))
+    Traceback (most recent call last):
+    ...
+    hybridsub._errors.MeshError: t.vtk: face 0 refers to vertex 999999999999, but there are only 3 (valid 0..2)
     """
-    V = mesh.vertices
-    if len(mesh.faces) == 0:
+    V, F = mesh.vertices, mesh.faces
+    if F.ndim != 2 or F.shape[1] != 3 or F.dtype.kind not in "iu":
+        raise MeshError(f"{path}: the faces were read as {F.dtype} of shape {F.shape}, not triangles of vertex "
+                        "indices: the file is damaged")
+    if len(F) == 0:
         raise MeshError(f"{path}: not a triangle mesh (it has no faces)")
     if V.ndim != 2 or V.shape[1] != 3:
         k = V.shape[1] if V.ndim == 2 else 1
@@ -234,7 +244,57 @@ def check_read(path: str, mesh: TaggedMesh) -> TaggedMesh:
         bad = V[i][~np.isfinite(V[i])][0]
         raise MeshError(f"{path}: vertex {i} has a non-finite coordinate ({bad}): every coordinate must be a finite "
                         "number" + (f" ({int((~finite).sum()):,} such vertices)" if (~finite).sum() > 1 else ""))
+    n, m = len(V), len(F)
+    _in_range(path, F, n, "face", "vertex")
+    E, s = mesh.sharp_edges, mesh.sharpness
+    if E.ndim != 2 or E.shape[1] != 2 or E.dtype.kind not in "iu":
+        raise MeshError(f"{path}: the creases were read as {E.dtype} of shape {E.shape}, not vertex pairs")
+    _in_range(path, E, n, "crease", "vertex")
+    if s.shape != (len(E),):
+        raise MeshError(f"{path}: {count_of(len(E), 'crease')} but {s.size} sharpness values")
+    bad = np.isnan(s) | (s <= 0)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"{path}: crease {j} {E[j].tolist()} has sharpness {s[j]}: a crease's sharpness is a "
+                        "positive number (10 or more: infinitely sharp)")
+    _in_range(path, np.asarray(mesh.corners).reshape(-1, 1), n, "corner", "vertex")
+    _in_range(path, np.asarray(mesh.sharp_faces).reshape(-1, 1), m, "sharp face", "face")
+    c = mesh.vertex_colors
+    if c is not None:
+        if c.ndim != 2 or c.shape[0] != n or c.shape[1] not in (3, 4):
+            raise MeshError(f"{path}: vertex colours of shape {c.shape}, for {count_of(n, 'vertex')} (one RGB or "
+                            "RGBA colour per vertex)")
+        if not np.isfinite(c).all():
+            i = int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])
+            raise MeshError(f"{path}: vertex {i} has a non-finite colour {c[i].tolist()}")
+    if (mesh.uv is None) != (mesh.face_uv is None):
+        raise MeshError(f"{path}: texture coordinates without their face indices (or the reverse)")
+    if mesh.uv is not None:
+        T, FT = mesh.uv, mesh.face_uv
+        if T.ndim != 2 or T.shape[1] != 2:
+            raise MeshError(f"{path}: texture coordinates of shape {T.shape}; a UV is two numbers")
+        if FT.shape != F.shape or FT.dtype.kind not in "iu":
+            raise MeshError(f"{path}: UV indices of shape {FT.shape} for {count_of(m, 'face')}")
+        _in_range(path, FT, len(T), "face", "UV")
+        if not np.isfinite(T).all():
+            i = int(np.flatnonzero(~np.isfinite(T).all(axis=1))[0])
+            raise MeshError(f"{path}: texture coordinate {i} is not finite ({T[i].tolist()})")
+    fm = mesh.face_material
+    if fm is not None and (fm.shape != (m,) or (m and (fm.min() < -1 or fm.max() >= len(mesh.materials)))):
+        raise MeshError(f"{path}: the faces' materials do not match the {count_of(len(mesh.materials), 'material')}")
     return mesh
+
+
+def _in_range(path: str, A: np.ndarray, n: int, row: str, what: str) -> None:
+    """MeshError naming the first row of ``A`` (called ``row``) that names a ``what`` outside 0..n-1."""
+    if A.size == 0:
+        return
+    bad = ((A < 0) | (A >= n)).any(axis=1)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        i = int(A[j][(A[j] < 0) | (A[j] >= n)][0])
+        valid = f"valid 0..{n - 1}" if n else "there are none"
+        raise MeshError(f"{path}: {row} {j} refers to {what} {i}, but there are only {n} ({valid})")
 
 
 def sharpness_from_file(s: np.ndarray) -> np.ndarray:

@@ -6,9 +6,14 @@ Abaqus, …): triangles, with the tags as cells of their own where the format ho
 
 from __future__ import annotations
 
+import contextlib
+import io
+import re
+
 import numpy as np
 
 from .._errors import MeshError
+from .._input import count_of
 from .mesh import INFINITE, TaggedMesh, color_bytes, describe_tags, sharpness_from_file, sharpness_to_file
 from .tables import triangulate_polygons
 
@@ -36,19 +41,19 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     >>> m.faces.tolist(), m.corners.tolist()
     ([[0, 1, 2]], [1])
     """
-    import meshio
-
-    try:
-        mesh = meshio.read(path)
-    except Exception as e:  # meshio raises many kinds of errors on bad files
-        raise MeshError(f"{path}: meshio cannot read it: {type(e).__name__}: {e}") from None
+    mesh, said = _meshio_read(path)
     P = np.asarray(mesh.points, dtype=np.float64)
     if P.ndim != 2 or P.shape[1] not in (2, 3):
         raise MeshError(f"{path}: points of shape {P.shape}; a surface mesh needs 2 or 3 coordinates")
     V = np.pad(P, ((0, 0), (0, 3 - P.shape[1])))
     polys, sharp_face, pairs, psharp, corners, notes = [], [], [], [], [], []
+    _check_cells(path, mesh, len(V))
     for i, block in enumerate(mesh.cells):
-        data = {k: np.asarray(v[i]).reshape(len(block.data), -1) for k, v in mesh.cell_data.items()}
+        try:
+            data = {k: np.asarray(v[i], np.float64).reshape(len(block.data), -1) for k, v in mesh.cell_data.items()}
+        except (ValueError, TypeError, IndexError):
+            raise MeshError(f"{path}: the cell data of the {block.type} cells does not match the cells (one value "
+                            "per cell)") from None
         if block.type in _VOLUME:
             raise MeshError(f"{path}: holds {block.type} cells, a volume mesh; hybridsub subdivides surfaces "
                             "(extract the boundary first: pyvista's extract_surface())")
@@ -67,52 +72,148 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     mask = np.concatenate(sharp_face) if sharp_face else np.zeros(0, bool)
     sf = np.flatnonzero(mask[origin] if origin is not None else mask)
     E = np.concatenate(pairs) if pairs else np.empty((0, 2), np.int64)
-    s = sharpness_from_file(np.concatenate(psharp)) if psharp else np.empty(0)
+    s = np.concatenate(psharp) if psharp else np.empty(0)
+    if np.isnan(s).any():
+        j = int(np.flatnonzero(np.isnan(s))[0])
+        raise MeshError(f"{path}: crease (line cell) {j} has sharpness nan")
+    E, s = E[s > 0], sharpness_from_file(s[s > 0])
     C = np.unique(np.concatenate(corners)) if corners else np.empty(0, np.int64)
     colors = uv = face_uv = None
     pd = mesh.point_data
     if "colors" in pd:
         c = np.asarray(pd["colors"])
         colors = c / 255.0 if c.dtype.kind in "iu" else c.astype(np.float64)
+        if colors.ndim != 2 or len(colors) != len(V):
+            raise MeshError(f"{path}: point data 'colors' of shape {c.shape} for {len(V)} points")
     if "uv" in pd:
-        uv, face_uv = np.asarray(pd["uv"], np.float64)[:, :2], F.copy()
+        uv = np.asarray(pd["uv"], np.float64)
+        if uv.ndim != 2 or uv.shape[0] != len(V) or uv.shape[1] < 2:
+            raise MeshError(f"{path}: point data 'uv' of shape {uv.shape} for {len(V)} points")
+        uv, face_uv = uv[:, :2], F.copy()
     if origin is not None:
         notes.append(f"triangulated {len(polys)} polygons into {len(F)} triangles")
+    notes += said
     return TaggedMesh(V, F, E, s, C, sf.astype(np.int64), colors, uv, face_uv, tuple(notes))
+
+
+def _meshio_read(path: str):
+    """``meshio.read(path)`` and what meshio said on the way (its warnings, as notes). On a file
+    it cannot read, meshio prints the reason and calls ``sys.exit(1)``: that ``SystemExit`` (and
+    any other exception) is answered here with one MeshError naming the file and meshio's reason;
+    so are cells of types meshio does not know, which it would drop.
+    meshio's messages go to stdout and stderr; they are caught while it reads, so they become
+    the error or the notes instead of lines on the caller's terminal."""
+    import meshio
+
+    out = io.StringIO()
+    failed = None
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+            mesh = meshio.read(path)
+    except SystemExit:  # meshio's own "Couldn't read file … as vtk"
+        failed = ""
+    except MemoryError:
+        failed = "it declares more data than fits in memory"
+    except Exception as e:  # meshio raises many kinds of errors on bad files
+        failed = f"{type(e).__name__}: {e}"
+    text = " ".join(out.getvalue().split())  # rich wraps long lines: messages are told apart by their prefix
+    said = [m.strip() for m in re.split(r"(?=\b(?:Warning|Error): )", text) if m.strip()]
+    said = [m.removeprefix("Warning: ") for m in said if not m.startswith("Error: Couldn't read file")]
+    if failed is not None:
+        reason = "; ".join(x for x in [*said, failed] if x and not x.startswith("Error: Couldn't read"))
+        raise MeshError(f"{path}: meshio cannot read it" + (f" ({reason})" if reason else " (the file is damaged)"))
+    dropped = _dropped_cells(path, mesh)
+    if dropped:  # meshio leaves them out: read on, the surface would have holes where they were
+        types = sorted({m.group(1) for s in said for m in re.finditer(r"cannot handle \(type (-?\d+)\)", s)}, key=int)
+        kinds = f" (VTK cell type{'s' * (len(types) > 1)} {', '.join(types)})" if types else ""
+        raise MeshError(f"{path}: {count_of(dropped, 'cell')} of a type meshio cannot read{kinds}: they would be "
+                        "left out without a word, and the surface would have holes there")
+    return mesh, [f"meshio: {s}" for s in said if "only meant for debugging" not in s]
+
+
+def _dropped_cells(path: str, mesh) -> int:
+    """How many cells the file declares beyond those meshio returned (meshio skips cells of
+    types it does not know, saying so only on the terminal): VTK's ``CELL_TYPES n``, VTU's
+    ``NumberOfCells``; 0 for other formats or when the declaration is not found."""
+    ext = path.lower().rsplit(".", 1)[-1]
+    if ext not in ("vtk", "vtu"):
+        return 0
+    with open(path, "rb") as fh:
+        raw = fh.read()
+    pattern = rb"CELL_TYPES\s+(\d+)" if ext == "vtk" else rb"NumberOfCells\s*=\s*[\"'](\d+)"
+    declared = sum(int(m.group(1)) for m in re.finditer(pattern, raw))
+    got = sum(len(b.data) for b in mesh.cells)
+    return max(0, declared - got) if declared else 0
+
+
+def _check_cells(path: str, mesh, n: int) -> None:
+    """MeshError naming the first cell that refers to a point outside 0..n-1 (meshio returns
+    such cells as the file has them)."""
+    for block in mesh.cells:
+        if block.type.startswith("polyhedron"):  # a volume cell: refused below
+            continue
+        A = np.asarray(block.data)
+        if A.size == 0:
+            continue
+        if A.dtype.kind not in "iu":
+            raise MeshError(f"{path}: the {block.type} cells hold point indices of type {A.dtype}")
+        A = A.reshape(len(A), -1)
+        bad = ((A < 0) | (A >= n)).any(axis=1)
+        if bad.any():
+            j = int(np.flatnonzero(bad)[0])
+            i = int(A[j][(A[j] < 0) | (A[j] >= n)][0])
+            valid = f"valid 0..{n - 1}" if n else "there are none"
+            raise MeshError(f"{path}: {block.type} cell {j} refers to point {i}, but there are only {n} ({valid})")
+
+
+#: The meshio formats that keep the tag cells and their cell data through a write and a read
+#: (checked for VTK and VTU in tests/test_damaged_files.py); every other meshio format is written
+#: as triangles alone, and the tags are reported dropped (Medit's .mesh, for one, writes the
+#: line cells but not their sharpness, so the creases would be lost without a word).
+TAGGED_FORMATS = (".vtk", ".vtu", ".xdmf", ".xmf")
 
 
 def write_meshio(path: str, m: TaggedMesh) -> str:
     """Write ``m`` through meshio; returns a description of the tags the format could not hold
-    ('' if none): a format without mixed cells or cell data gets the triangles alone."""
+    ('' if none): a format not in ``TAGGED_FORMATS`` gets the triangles alone."""
     import meshio
 
-    cells = [("triangle", m.faces)]
-    sharp = [np.zeros(len(m.faces))]
-    sf = np.zeros(len(m.faces), np.uint8)
-    sf[m.sharp_faces] = 1
-    marks = [sf]
-    if len(m.sharp_edges):
-        cells.append(("line", m.sharp_edges))
-        sharp.append(sharpness_to_file(m.sharpness))
-        marks.append(np.zeros(len(m.sharp_edges), np.uint8))
-    if len(m.corners):
-        cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
-        sharp.append(np.full(len(m.corners), INFINITE))
-        marks.append(np.zeros(len(m.corners), np.uint8))
     point_data = {}
     if m.vertex_colors is not None:
         point_data["colors"] = color_bytes(m.vertex_colors)
     if m.vertex_uv is not None:
         point_data["uv"] = m.vertex_uv
-    tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
-                         cell_data={"sharpness": sharp, "sharp_face": marks})
-    try:
-        tagged.write(path)
+    name = path.lower()
+    if m.has_tags and name.endswith(TAGGED_FORMATS):
+        cells = [("triangle", m.faces)]
+        sharp = [np.zeros(len(m.faces))]
+        sf = np.zeros(len(m.faces), np.uint8)
+        sf[m.sharp_faces] = 1
+        marks = [sf]
+        if len(m.sharp_edges):
+            cells.append(("line", m.sharp_edges))
+            sharp.append(sharpness_to_file(m.sharpness))
+            marks.append(np.zeros(len(m.sharp_edges), np.uint8))
+        if len(m.corners):
+            cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
+            sharp.append(np.full(len(m.corners), INFINITE))
+            marks.append(np.zeros(len(m.corners), np.uint8))
+        tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
+                             cell_data={"sharpness": sharp, "sharp_face": marks})
+        _meshio_write(path, tagged)
         return ""
-    except Exception:  # the format cannot hold lines, vertices or cell data: triangles alone
-        pass
     try:
-        meshio.Mesh(m.vertices, [("triangle", m.faces)]).write(path)
+        _meshio_write(path, meshio.Mesh(m.vertices, [("triangle", m.faces)], point_data=point_data))
+    except MeshError:
+        if not point_data:
+            raise
+        _meshio_write(path, meshio.Mesh(m.vertices, [("triangle", m.faces)]))  # a format without point data
+    return describe_tags(m)
+
+
+def _meshio_write(path: str, mesh) -> None:
+    try:
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            mesh.write(path)
     except Exception as e:
         raise MeshError(f"{path}: meshio could not write it: {type(e).__name__}: {e}") from None
-    return describe_tags(m)

@@ -29,11 +29,7 @@ def read_npz(path: str) -> TaggedMesh:
     """
     if not zipfile.is_zipfile(path):
         raise MeshError(f"{path}: not an NPZ file (NumPy's savez writes a zip archive; this is not one)")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
-        raise MeshError(f"{path}: not a readable NPZ file ({type(e).__name__}: {e})") from None
+    arrays = _read_arrays(path)
     missing = [k for k in ("vertices", "faces") if k not in arrays]
     if missing:
         raise MeshError(f"{path}: an NPZ mesh needs arrays 'vertices' and 'faces'; it has no {missing[0]!r} "
@@ -45,11 +41,46 @@ def read_npz(path: str) -> TaggedMesh:
         raise MeshError(f"{path}: 'face_uv' needs a 'uv' array")
     try:
         mesh = as_tagged(*(arrays.get(k) for k in NPZ_ARRAYS))
-    except (MeshError, TypeError) as e:
+    except (ValueError, TypeError) as e:
         raise MeshError(f"{path}: {e}") from None
     ignored = sorted(set(arrays) - set(NPZ_ARRAYS))
     notes = (f"ignored arrays: {', '.join(ignored)}",) if ignored else ()
     return replace(mesh, notes=notes)
+
+
+def _read_arrays(path: str) -> dict[str, np.ndarray]:
+    """The ``.npy`` members of the zip archive ``path`` by name. Each member's header is read
+    first and its declared shape checked against the member's size, so a damaged header that
+    declares terabytes is refused before anything is allocated; every failure (a damaged zip, a
+    header NumPy cannot parse, an object array, data cut short) is one MeshError naming the member."""
+    out = {}
+    try:
+        z = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError, NotImplementedError) as e:
+        raise MeshError(f"{path}: not a readable NPZ file ({type(e).__name__}: {e})") from None
+    with z:
+        for info in z.infolist():
+            name = info.filename
+            key = name[:-4] if name.endswith(".npy") else name
+            try:
+                with z.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    shape, fortran, dtype = (np.lib.format.read_array_header_1_0(fh) if version == (1, 0)
+                                             else np.lib.format.read_array_header_2_0(fh))
+                    if dtype.hasobject:
+                        raise ValueError("an array of Python objects (pickled), which is not read")
+                    need = int(np.prod(shape, dtype=object)) * dtype.itemsize
+                    if need > info.file_size:
+                        raise ValueError(f"its header declares shape {shape} of {dtype} ({need:,} bytes), but the "
+                                         f"member holds {info.file_size:,} bytes")
+                with z.open(info) as fh:
+                    out[key] = np.lib.format.read_array(fh, allow_pickle=False)
+            except MemoryError:
+                raise MeshError(f"{path}: array {key!r} does not fit in memory") from None
+            except Exception as e:  # zipfile and numpy raise many kinds of errors on a damaged member
+                raise MeshError(f"{path}: not a readable NPZ file: array {key!r} cannot be read ({type(e).__name__}: "
+                                f"{e})") from None
+    return out
 
 
 def write_npz(path: str, m: TaggedMesh) -> None:

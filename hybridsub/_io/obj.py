@@ -20,7 +20,7 @@ from .._input import count_of
 from .._topology import group_halfedges, halfedge_ends
 from .._version import __version__
 from .mesh import INFINITE, TaggedMesh, describe_tags, sharpness_from_file, sharpness_to_file, unit_colors
-from .tables import check_faces, check_indices, text_rows, triangulate_polygons
+from .tables import MAX_INDEX, check_faces, check_indices, text_rows, triangulate_polygons
 
 
 # ----------------------------------------------------------------------------------------------
@@ -282,7 +282,13 @@ def _tag_values(where: str, w: list[str]) -> tuple[str, list[int], list[float]]:
         floats = [float(x) for x in w[2 + nint:2 + nint + nfloat]]
         if len(ints) != nint or len(floats) != nfloat or len(w) < 2 + nint + nfloat + nstr:
             raise ValueError
-    except (IndexError, ValueError):
+        if any(abs(i) > MAX_INDEX for i in ints):
+            raise MeshError(f"{where}: tag {' '.join(['t'] + w[:2])!r} holds an index too large for any mesh")
+        if any(f != f for f in floats):
+            raise MeshError(f"{where}: tag {' '.join(['t'] + w[:2])!r} holds a sharpness that is not a number (nan)")
+    except (IndexError, ValueError) as e:
+        if isinstance(e, MeshError):
+            raise
         raise MeshError(f"{where}: cannot read tag {' '.join(['t'] + w)!r} "
                         "(expected 't NAME NINT/NFLOAT/NSTRING ints floats strings')") from None
     return name, ints, floats

@@ -34,12 +34,14 @@ def read_off_mesh(path: str, triangulate: bool) -> TaggedMesh:
         raise MeshError(f"{path}: not an OFF file (it must start with 'OFF')")
     head = lines[0]
     colored = "C" in head[0]
-    rest = head[1:] if len(head) > 1 else lines[1]
+    rest = head[1:] if len(head) > 1 else lines[1] if len(lines) > 1 else []
     body = lines[1:] if len(head) > 1 else lines[2:]
     try:
         nv, nf = int(rest[0]), int(rest[1])
+        if nv < 0 or nf < 0:
+            raise ValueError
     except (IndexError, ValueError):
-        raise MeshError(f"{path}: the OFF header needs vertex and face counts") from None
+        raise MeshError(f"{path}: the OFF header needs vertex and face counts (whole numbers >= 0)") from None
     if len(body) < nv + nf:
         raise MeshError(f"{path}: the file ends early: the header promises {nv} vertices and {nf} faces")
     try:

@@ -14,6 +14,7 @@ record in Python, about 100 times slower than one NumPy record array.
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -68,6 +69,8 @@ def _parse_header(raw: bytes, path: str):
             if w[0] == "format":
                 fmt = w[1]
             elif w[0] == "element":
+                if not w[2].isdigit():
+                    raise ValueError("an element count is a whole number >= 0")
                 elements.append(_Element(w[1], int(w[2])))
             elif w[0] == "property":
                 if not elements:
@@ -101,45 +104,75 @@ def _read_ascii(body: bytes, elements: list[_Element], path: str) -> None:
         tokens = [r.split() for r in rows]
         widths = {len(t) for t in tokens}
         try:
-            if len(widths) == 1:
-                table = np.array(tokens, dtype=np.float64)
-                col = 0
-                for p in el.props:
-                    if len(p) == 2:
-                        el.data[p[0]] = table[:, col].astype(p[1])
-                        col += 1
-                    else:
-                        n = table[:, col].astype(np.int64)
-                        if (n != n[0]).any():
-                            raise _Ragged
-                        el.data[p[0]] = table[:, col + 1:col + 1 + n[0]].astype(p[2])
-                        col += 1 + int(n[0])
-            else:
+            if len(widths) != 1:
                 raise _Ragged
+            try:
+                table = np.array(tokens, dtype=np.float64)
+            except ValueError:
+                raise _Ragged from None  # the row by row reader names the row
+            col = 0
+            for p in el.props:
+                if col >= table.shape[1]:
+                    raise _Ragged
+                if len(p) == 2:
+                    el.data[p[0]] = _typed(path, el, p[0], table[:, col], p[1])
+                    col += 1
+                else:
+                    n = _typed(path, el, p[0] + " (its length)", table[:, col], "i8")
+                    if (n != n[0]).any() or n[0] < 0 or col + 1 + n[0] > table.shape[1]:
+                        raise _Ragged
+                    el.data[p[0]] = _typed(path, el, p[0], table[:, col + 1:col + 1 + n[0]], p[2])
+                    col += 1 + int(n[0])
         except _Ragged:
-            _ascii_rows(tokens, el)
-        except ValueError as e:
-            raise MeshError(f"{path}: element '{el.name}' holds a value that is not a number ({e})") from None
+            _ascii_rows(path, tokens, el)
 
 
 class _Ragged(Exception):
     pass
 
 
-def _ascii_rows(tokens: list[list[str]], el: _Element) -> None:
+def _typed(path: str, el: _Element, prop: str, values: np.ndarray, dtype: str, row: int | None = None) -> np.ndarray:
+    """``values`` (floats as read) as ``dtype``; an integer property must hold whole numbers in
+    its type's range (a NaN or 1e30 would become some arbitrary index)."""
+    if np.dtype(dtype).kind in "iu":
+        info = np.iinfo(dtype)
+        bad = ~np.isfinite(values) | (values != np.round(values)) | (values < info.min) | (values > info.max)
+        if bad.any():
+            i = np.unravel_index(int(np.flatnonzero(bad)[0]), values.shape)
+            r = row if row is not None else int(i[0])
+            raise MeshError(f"{path}: element '{el.name}' row {r}: {prop} is {float(values[i])!r}, not a whole number "
+                            f"of type {dtype}")
+    return values.astype(dtype)
+
+
+def _ascii_rows(path: str, tokens: list[list[str]], el: _Element) -> None:
     cols: dict[str, list] = {p[0]: [] for p in el.props}
-    for t in tokens:
+    for r, t in enumerate(tokens):
         i = 0
-        for p in el.props:
-            if len(p) == 2:
-                cols[p[0]].append(float(t[i]))
-                i += 1
-            else:
-                n = int(float(t[i]))
-                cols[p[0]].append(np.array(t[i + 1:i + 1 + n], dtype=np.float64).astype(p[2]))
-                i += 1 + n
+        try:
+            for p in el.props:
+                if len(p) == 2:
+                    cols[p[0]].append(float(t[i]))
+                    i += 1
+                else:
+                    n = int(_typed(path, el, p[0] + " (its length)", np.array([float(t[i])]), "i8", r)[0])
+                    if n < 0 or i + 1 + n > len(t):
+                        raise MeshError(f"{path}: element '{el.name}' row {r}: a list of {n} values, but the row "
+                                        f"holds {len(t) - i - 1} more")
+                    cols[p[0]].append(_typed(path, el, p[0], np.array(t[i + 1:i + 1 + n], dtype=np.float64), p[2], r))
+                    i += 1 + n
+        except IndexError:
+            raise MeshError(f"{path}: element '{el.name}' row {r} holds {len(t)} values, fewer than its properties "
+                            f"({', '.join(p[0] for p in el.props)}) need") from None
+        except ValueError as e:
+            if isinstance(e, MeshError):
+                raise
+            raise MeshError(f"{path}: element '{el.name}' row {r} holds a value that is not a number ({e})") from None
     for p in el.props:
-        el.data[p[0]] = np.array(cols[p[0]], dtype=p[1]) if len(p) == 2 else cols[p[0]]
+        if len(p) == 2:
+            el.data[p[0]] = _typed(path, el, p[0], np.array(cols[p[0]], dtype=np.float64), p[1])
+        else:
+            el.data[p[0]] = cols[p[0]]
 
 
 def _empty(el: _Element) -> None:
@@ -157,6 +190,28 @@ def _read_ply_ascii(path: str) -> tuple[dict[str, dict[str, Any]], list[str]]:
     return {e.name: e.data for e in elements}, comments
 
 
+def _check_binary_counts(path: str) -> None:
+    """MeshError where a binary PLY header declares more elements than the file's size can hold
+    (each record takes at least its scalars and its lists' counts): before plyfile allocates
+    for them, or fails on a count that does not fit an index."""
+    size = os.path.getsize(path)
+    raw = b""
+    with open(path, "rb") as fh:
+        while b"end_header" not in raw and len(raw) < size:
+            raw += fh.read(1 << 20)
+    if b"end_header" not in raw:
+        return  # plyfile says what is wrong with the header
+    _fmt, elements, stop, _ = _parse_header(raw, path)
+    left = size - stop
+    for el in elements:
+        least = sum(np.dtype(p[1]).itemsize for p in el.props)
+        if el.count * least > left:
+            raise MeshError(f"{path}: the header declares {el.count:,} '{el.name}' elements, at least "
+                            f"{el.count * least:,} bytes, but only {left:,} bytes follow: the file is damaged or cut "
+                            "short")
+        left -= el.count * least
+
+
 def read_ply(path: str) -> tuple[dict[str, dict[str, Any]], list[str]]:
     """Every element of a PLY file, through plyfile: ``({element: {property: values}}, comments)``.
 
@@ -169,6 +224,7 @@ def read_ply(path: str) -> tuple[dict[str, dict[str, Any]], list[str]]:
         head = fh.read(64)
     if b"format ascii" in head:
         return _read_ply_ascii(path)
+    _check_binary_counts(path)
     try:
         try:
             data = plyfile.PlyData.read(path, known_list_len=_KNOWN_LISTS)
@@ -186,8 +242,8 @@ def read_ply(path: str) -> tuple[dict[str, dict[str, Any]], list[str]]:
         if "end-of-file" in e.message:
             raise MeshError(f"{path}: the file ends inside element '{e.element.name}' ({e.message}{where})") from None
         raise MeshError(f"{path}: PLY data not valid: {e.message}{where}") from None
-    except (ValueError, EOFError) as e:
-        raise MeshError(f"{path}: not a valid PLY file ({e})") from None
+    except (ValueError, EOFError, OverflowError, IndexError, KeyError, TypeError) as e:
+        raise MeshError(f"{path}: not a valid PLY file ({type(e).__name__}: {e})") from None
     out: dict[str, dict[str, Any]] = {}
     for el in data.elements:
         cols: dict[str, Any] = {}

@@ -10,7 +10,7 @@ import numpy as np
 from .._errors import MeshError
 
 #: Indices beyond this are refused on reading (they do not fit the int64 face arrays).
-_MAX_INDEX = np.iinfo(np.int64).max
+MAX_INDEX = np.iinfo(np.int64).max
 
 
 def triangulate_polygons(path: str, polys: list, triangulate: bool, what: str = "face"):
@@ -27,7 +27,7 @@ def triangulate_polygons(path: str, polys: list, triangulate: bool, what: str = 
         f = int(small[0])
         raise MeshError(f"{path}: {what} {f} has only {int(sizes[f])} vertices ({len(small)} such): a face needs "
                         "at least three")
-    huge = [f for f, p in enumerate(polys) if any(abs(i) > _MAX_INDEX for i in p)]
+    huge = [f for f, p in enumerate(polys) if any(abs(i) > MAX_INDEX for i in p)]
     if huge:
         digits = len(str(max(abs(i) for i in polys[huge[0]])))
         raise MeshError(f"{path}: {what} {huge[0]} holds a vertex index too large for any mesh ({digits} digits)")

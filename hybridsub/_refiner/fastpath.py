@@ -49,7 +49,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
-def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
+def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
@@ -119,7 +119,9 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
     >>> V, F = hybridsub.load_example()
     >>> V2, F2 = hybridsub.subdivide(V, F, levels=1, feature_angle=30)   # creases found and kept
     """
-    Vf, out_dtype = as_vertices(V, return_dtype=True)
+    Vf, out_dtype = as_vertices(V, return_dtype=True)  # (a mesh object: a TypeError naming subdivide_mesh)
+    if F is None:
+        raise TypeError("subdivide(V, F, ...) needs the faces F (an (m, 3) array of vertex indices)")
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
@@ -192,22 +194,25 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
 
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
-                     corners=None, loop_weights="loop", tags=True, max_memory=None) -> Iterator[LevelOutput]:
+                     corners=None, loop_weights="loop", tags=True, max_memory=None,
+                     non_manifold="raise") -> Iterator[LevelOutput]:
     """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
     (the command line's progress bar) or the propagated tags with the positions. ``X`` is
     any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
-    tags nor face parents are computed (nor the last level's twins). ``max_memory`` as in :func:`subdivide`.
+    tags nor face parents are computed (nor the last level's twins). ``max_memory`` and
+    ``non_manifold`` as in :func:`subdivide` (with ``"cut"`` the levels are those of the cut mesh).
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
-                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory)
-    yield from walk_data(inp, X, tags=tags)
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
+                    non_manifold=non_manifold)
+    yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], tags=tags)
 
 
 def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_edges=None, levels: int = 1, *,
                                   scheme="hybrid", uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
-                                  loop_weights="loop", max_memory=None) -> Iterator[LevelOutput]:
+                                  loop_weights="loop", max_memory=None, non_manifold="raise") -> Iterator[LevelOutput]:
     """The face-varying fast path: yield a :class:`LevelOutput` (with ``UV`` and ``uv_faces``)
     per step, no matrix kept.
 
@@ -217,5 +222,5 @@ def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_e
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV")
-    yield from walk_data(inp, X, UV)
+                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold)
+    yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], UV)

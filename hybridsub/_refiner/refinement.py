@@ -284,6 +284,8 @@ class Refinement:
 
         ``reconstruct(*decompose(X)) == X`` to rounding. With details in local frames, edited
         coarse positions carry the details along (each frame is computed on the edited mesh).
+        Details made by another refinement (other faces, scheme, weights or tags, even of the
+        same sizes) are refused: they carry a fingerprint of the refinement that made them.
 
         Examples
         --------
@@ -297,7 +299,7 @@ class Refinement:
         True
         """
         from .._fit.multires import reconstruct
-        return reconstruct(self.steps, self.n_coarse, coarse, details)
+        return reconstruct(self.steps, self.n_coarse, coarse, details, self._cache)
 
 
 def _output_buffer(out, shape: tuple, work) -> np.ndarray:

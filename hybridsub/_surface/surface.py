@@ -3,11 +3,14 @@ derivatives, normals and closest points; every value a sparse row over the contr
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
+
 import numpy as np
 import scipy.sparse as sp
 
 from .._input import as_vertices, open_gate, writable
-from .._typing import ArrayLike, LoopWeights, Scheme
+from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .cache import PatchTable
 from .depth import PointDepths
 from .project import closest_points, seed_setup
@@ -33,8 +36,13 @@ class LimitSurface:
         Control vertices.
     F : (m, 3) array_like of int
         Triangles, as for :func:`hybridsub.refine`.
-    sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
-        As for :func:`hybridsub.refine`; every scheme and tag.
+    sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, non_manifold, max_memory
+        As for :func:`hybridsub.refine`; every scheme and tag. With ``non_manifold="cut"`` the
+        surface is that of the cut mesh (its faces are the input's, in the same order), and
+        every row or value is still over the caller's vertices.
+    feature_angle : float, optional
+        Also keep sharp the edges whose dihedral angle exceeds this many degrees, with their
+        corners, as for :func:`hybridsub.subdivide`.
     depth : int, optional
         Levels of exact local refinement before the last interpolation (default 18 for
         ``"hybrid"`` and ``"sqrt3"``, 14 for ``"loop"``). Points next to irregular
@@ -65,10 +73,18 @@ class LimitSurface:
 
     def __init__(self, V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *,
                  scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-                 corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", depth: int | None = None):
+                 corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                 feature_angle: float | None = None, non_manifold: NonManifold = "raise",
+                 max_memory: MemoryLimit = None, depth: int | None = None):
         X = as_vertices(V)
-        self._inp = open_gate(F, sharp_edges, 0, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
-                              sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+        inp = open_gate(F, sharp_edges, 0, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
+                        sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                        non_manifold=non_manifold, max_memory=max_memory, positions=X, feature_angle=feature_angle)
+        self._faces_in, self._copy = inp.faces, None
+        if inp.cut is not None:  # the surface of the cut mesh (a manifold input), over the caller's vertices
+            self._faces_in, self._copy = inp.uncut.faces, inp.cut.origin
+            inp = dataclasses.replace(inp, cut=None, uncut=None)
+        self._inp = inp
         self._V = X.copy()
         self._V.setflags(write=False)
         self._seeds = None
@@ -89,7 +105,7 @@ class LimitSurface:
     @property
     def faces(self) -> np.ndarray:
         """The input faces (m, 3), read-only view."""
-        F = self._inp.faces.view()
+        F = self._faces_in.view()
         F.setflags(write=False)
         return F
 
@@ -163,7 +179,15 @@ class LimitSurface:
         >>> M.shape, bool(np.allclose(M.sum(axis=1), 1))
         ((2, 4), True)
         """
-        return self._matrix(*self._points(face, bary), derivatives, self.depth)
+        mats = self._matrix(*self._points(face, bary), derivatives, self.depth)
+        if self._copy is None:
+            return mats
+        n, c = len(self._V), self._copy  # the cut mesh's copies are their vertices
+        C = sp.csr_matrix((np.ones(len(c)), (np.arange(len(c)), c)), shape=(len(c), n))
+        out = [sp.csr_matrix(M @ C) for M in (mats if derivatives else (mats,))]
+        for M in out:
+            M.sort_indices()
+        return tuple(out) if derivatives else out[0]
 
     def _chunks(self, f: np.ndarray, b: np.ndarray, work) -> list:
         """``work(f, b)`` on chunks of ``CHUNK`` points; the patch cache emptied before a chunk
@@ -236,12 +260,15 @@ class LimitSurface:
         norm = np.linalg.norm(N, axis=1, keepdims=True)
         return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
 
-    def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iter: int = 30):
+    def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iterations: int = 30,
+                max_iter: int | None = None):
         """Closest points of the limit surface: ``(face, bary, Q, dist)``.
 
         ``dist`` is signed: positive on the side the normals point to. Seeds come from a dense
         sampling of the surface; Gauss–Newton on (face, u, v) then walks across face
-        boundaries to the foot point (``docs/limit.md``).
+        boundaries to the foot point (``docs/limit.md``). ``max_iterations``: the most
+        Gauss–Newton steps per point (the name :func:`hybridsub.fit` uses; ``max_iter`` is its
+        deprecated alias).
 
         Examples
         --------
@@ -254,9 +281,15 @@ class LimitSurface:
         >>> bool(np.allclose(Q, P, atol=1e-12)), bool(np.isclose(dist[0], 0.01, atol=1e-12))
         (True, True)
         """
+        if max_iter is not None:
+            warnings.warn("LimitSurface.project(max_iter=) is deprecated: use max_iterations= (the name fit uses)",
+                          DeprecationWarning, stacklevel=2)
+            max_iterations = max_iter
+        max_iter = max_iterations
         X = self._V if vertices is None else as_vertices(vertices)
-        if len(X) != self._inp.n_vertices:
-            raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got {len(X)}")
+        if len(X) != len(self._V):
+            raise ValueError(f"vertices must have {len(self._V)} rows (the control mesh's), got {len(X)}")
+        X = X if self._copy is None else X[self._copy]
         pts = np.asarray(points, dtype=np.float64)
         if pts.ndim == 1 and pts.shape == (3,):
             pts = pts[None]
@@ -265,13 +298,17 @@ class LimitSurface:
         return closest_points(self, X, pts, max_iter)
 
     def _data(self, vertices):
+        """The control data of a call over the surface's own vertices (the cut mesh's copies
+        under ``non_manifold="cut"``; data already over the copies is taken as it is)."""
         if vertices is None:
-            return self._V
+            return self._V if self._copy is None else self._V[self._copy]
         X = np.asarray(vertices, dtype=np.float64)
-        if X.ndim not in (1, 2) or X.shape[0] != self._inp.n_vertices:
-            raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got shape "
+        if self._copy is not None and X.ndim in (1, 2) and X.shape[0] == len(self._copy):
+            return X
+        if X.ndim not in (1, 2) or X.shape[0] != len(self._V):
+            raise ValueError(f"vertices must have {len(self._V)} rows (the control mesh's), got shape "
                              f"{X.shape}")
-        return X
+        return X if self._copy is None else X[self._copy]
 
     def _seed_setup(self):
         """The limit points of two refined levels and where they lie (computed once)."""

@@ -145,7 +145,8 @@ def _vertex_normals(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> np.nd
 def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
                  n_vertices: int | None = None, scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                  sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
-                 loop_weights: LoopWeights = "loop", tol: float = 1e-12, max_levels: int = 60) -> sp.csr_matrix:
+                 loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
+                 vertices: ArrayLike | None = None, tol: float = 1e-12, max_levels: int = 60) -> sp.csr_matrix:
     """The limit matrix: where every vertex of a level goes when refined forever.
 
     Parameters
@@ -162,6 +163,13 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         The subdivision scheme whose limit is meant.
     sharpness, sharp_faces, corners, loop_weights
         As for :func:`hybridsub.refine`.
+    feature_angle : float, optional
+        Also keep sharp the edges whose dihedral angle exceeds this many degrees, with their
+        corners, as for :func:`hybridsub.limit_positions`; the angles are measured on
+        ``vertices``, which it needs.
+    vertices : (n, 3) array_like of float, optional
+        Positions: used only to detect features (the matrix itself depends on the
+        connectivity and tags alone).
     tol : float
         Vertices without a stationary limit mask (``docs/limit.md``) are refined locally until
         their weights change by less than this.
@@ -185,7 +193,16 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
     array([[0.4, 0.2, 0.2, 0.2]])
     """
     tol, max_levels = _check_tol(tol, max_levels)
-    s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+    Vf = None
+    if feature_angle is not None:
+        if vertices is None:
+            raise TypeError("limit_matrix(feature_angle=...) needs vertices= (the positions the angles are measured on)")
+        Vf = as_vertices(vertices)
+        if n_vertices is not None and n_vertices != len(Vf):
+            raise ValueError(f"n_vertices={n_vertices} but vertices has {len(Vf)} rows")
+        n_vertices = len(Vf)
+    s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+                    positions=Vf, feature_angle=feature_angle)
     r = s.refinement
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
