@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import sys
 import time
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -154,7 +155,9 @@ def warm_up(quiet: bool = False) -> float:
     start = time.perf_counter()
     for what, job in JOBS:
         t = time.perf_counter()
-        job()
+        with warnings.catch_warnings():  # what the small calls warn of (a fit with few points) is not news
+            warnings.simplefilter("ignore")
+            job()
         if not quiet:
             print(f"  {what}: {time.perf_counter() - t:.1f} s", file=sys.stderr, flush=True)
     return time.perf_counter() - start
