@@ -279,7 +279,9 @@ def test_points_next_to_irregular_vertices_and_creases_are_exact(name, mesh):
     """Round irregular vertices and along split edges beside √3 faces the last interpolation
     is off by a fraction of the distance at any fixed depth (3e-7 × diagonal next to a
     valence-9 vertex at depth 14 or 18, 5e-9 next to a hybrid crease vertex at 24): such
-    points are walked deeper (``_surface/depth.py``) and equal a walk to depth 56."""
+    points are walked deeper (``_surface/depth.py``) and equal a walk to depth 56. (That is
+    convergence in depth only: both walks share the chart; the oracles that do not are in
+    ``test_limit_oracle.py``.)"""
     if name in ("sqrt3-boundary", "hybrid-boundary"):
         V, F = mesh("mesh_with_border")
         kw = dict(scheme=name.split("-")[0])
