@@ -260,3 +260,42 @@ def test_twins_of_a_high_valence_fan_match_brute_force(valence):
     assert twin.tolist() == expected
     with pytest.raises(hybridsub.MeshError):
         build_level(np.vstack([F, F[:1]]), int(F.max()) + 1)
+
+
+@pytest.mark.parametrize("threads", [False, True])
+def test_even_sqrt3_steps_keep_the_boundary_of_faces_with_two_or_three_boundary_edges(threads):
+    """Kobbelt's even steps trisect the boundary edge of a face with one; a face with two or
+    three keeps them (a call never meets one, every call starting with an odd step, but the
+    limit surface's patches do, at their cut). The step is then a valid mesh whose twins are
+    what a search finds, on one thread and in chunks: a face with two trisected edges read a
+    twin across its other boundary edge (index −1), and left another halfedge's twin and
+    edge point unwritten (issue 30: ``a child corner is not a combination of its parent's
+    neighbourhood``, depending on what memory held)."""
+    from hybridsub._rules import step_rules as R
+    from hybridsub._topology import build_level, child_level, plan_step
+
+    # A fan of three faces and a strip of three (their outer faces have two boundary edges,
+    # the middle ones one) and a lone triangle (three).
+    F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [5, 6, 7], [8, 9, 10], [10, 9, 11], [10, 11, 12]])
+    level = build_level(F, 13)
+    corner = np.zeros(13, bool)
+    plan = plan_step(level, corner, "sqrt3", 2, "loop")
+    assert (plan.edge_point[plan.edge_point >= 0] >= 13).all()
+    kinds = plan.hkind.reshape(-1, 3)
+    lone = (level.twin.reshape(-1, 3) < 0).sum(axis=1) == 1
+    assert lone.sum() == 2 and ((level.twin.reshape(-1, 3) < 0).sum(axis=1) > 1).sum() == 5
+    assert (kinds[~lone] != R.EDGE_TRISECT).all() and (plan.face_point[~lone] >= 0).all()
+    assert (kinds[lone] == R.EDGE_TRISECT).sum() == 2 and (plan.face_point[lone] < 0).all()
+    faces, child, _ = child_level(level, plan)
+    twin, err = K.twin_search(child.faces, child.n_vertices)
+    assert err == K.OK and np.array_equal(child.twin, twin)
+    assert set(np.unique(faces)) == set(range(plan.n_new))  # every vertex used, old ones too
+    if threads:
+        m, n = level.n_faces, level.n_vertices
+        out = [(np.empty(3 * m, np.int8), np.full(3 * m, -7, np.int32), np.empty(m, np.int32), np.empty(m, np.int8),
+                np.zeros((6, n), np.int64), np.zeros(n)) for _ in range(2)]
+        args = (level.faces, level.twin, np.empty(0), False, level.face_sharp, False, np.zeros(0, bool),
+                R.SCHEME_CODES["sqrt3"], False)
+        assert C.classify_step(*args, *out[0]) == C.classify_step_chunks(*args, *out[1], 3)
+        for a, b in zip(*out):
+            assert a.tobytes() == b.tobytes()

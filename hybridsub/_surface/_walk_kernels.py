@@ -60,7 +60,7 @@ def _pick_one(q, k, bary, grad, cand_start, cand_count, M, b):
 
 
 def _walk_known(todo, level, state, keys, path, stop, bary, grad, cand_start, cand_count, M, child, regular,
-                stop_regular, depth):
+                stop_regular, depth, at_vertex, vertex_stop, every):
     """The walk (``walk._descend``) of the points ``todo`` as far as the table knows the way.
 
     Point ``q`` is at ``level[q]`` on key ``keys[q, level[q]]`` (``state[q]`` 1: it has
@@ -68,8 +68,12 @@ def _walk_known(todo, level, state, keys, path, stop, bary, grad, cand_start, ca
     choosing a child per level (``_pick_one``), to ``depth[q]`` or (with ``stop_regular``) to
     the first regular key, and then ``stop[q]`` is set and ``state[q]`` 0; or it halts at a
     key whose candidates are not known (``state[q]`` 2) or at a candidate whose child patch is
-    not cut (``state[q]`` 1) for the caller to fill the table and call again. Threaded over
-    tasks of points (``walk_known``; ``walk_known_serial`` the same on one thread)."""
+    not cut (``state[q]`` 1) for the caller to fill the table and call again.
+    ``at_vertex[q]`` (−1 on the first call) gets the first level (a multiple of ``every``:
+    2 for Kobbelt's boundary, whose limits are taken at even levels) where the point is a
+    vertex of its face (``AT_VERTEX``); with ``vertex_stop`` it stops there, its value being
+    that vertex's limit position. Threaded over tasks of points (``walk_known``;
+    ``walk_known_serial`` the same on one thread)."""
     for task in prange((len(todo) + TASK - 1) // TASK):
         b = np.empty(3)
         for i in range(task * TASK, min(len(todo), (task + 1) * TASK)):
@@ -81,6 +85,12 @@ def _walk_known(todo, level, state, keys, path, stop, bary, grad, cand_start, ca
             state[q] = 0
             while True:
                 k = keys[q, lev]
+                if (at_vertex[q] < 0 and lev % every == 0
+                        and max(bary[q, 0], bary[q, 1], bary[q, 2]) >= 1.0 - AT_VERTEX):
+                    at_vertex[q] = lev
+                    if vertex_stop:
+                        stop[q] = lev
+                        break
                 if (stop_regular and regular[k] == 1) or lev == depth[q]:
                     stop[q] = lev
                     break

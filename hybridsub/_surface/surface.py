@@ -9,6 +9,7 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
+from .._errors import MeshError
 from .._input import as_vertices, open_gate, writable
 from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .cache import PatchTable
@@ -25,6 +26,18 @@ CACHE_BYTES = 2**29
 def _default_depth(scheme: str) -> int:
     # Chart size after the descent: 3^(-depth/2) for √3 faces, 2^(-depth) for Loop faces.
     return 14 if scheme == "loop" else 18
+
+
+def unit_normals(Du: np.ndarray, Dv: np.ndarray) -> np.ndarray:
+    """Unit ``Du × Dv`` per row (zero where it vanishes), from tangents scaled to unit size
+    first, so that neither huge nor tiny coordinates overflow or underflow the product."""
+    su = np.abs(Du).max(axis=1, keepdims=True)
+    sv = np.abs(Dv).max(axis=1, keepdims=True)
+    U = np.divide(Du, su, out=np.zeros_like(Du), where=su > 0)
+    W = np.divide(Dv, sv, out=np.zeros_like(Dv), where=sv > 0)
+    N = np.cross(U, W)
+    norm = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
 
 
 class LimitSurface:
@@ -255,10 +268,12 @@ class LimitSurface:
         >>> N.round(6).tolist()                       # the face (1, 2, 3) faces away from 0
         [[0.57735, 0.57735, 0.57735]]
         """
+        if vertices is not None:
+            X = np.asarray(vertices)
+            if X.ndim != 2 or X.shape[1] != 3:
+                raise ValueError(f"normals need (n, 3) vertices, got shape {X.shape}")
         _, Du, Dv = self.evaluate(face, bary, derivatives=True, vertices=vertices)
-        N = np.cross(Du, Dv)
-        norm = np.linalg.norm(N, axis=1, keepdims=True)
-        return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
+        return unit_normals(Du, Dv)
 
     def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iterations: int = 30,
                 max_iter: int | None = None):
@@ -302,13 +317,19 @@ class LimitSurface:
         under ``non_manifold="cut"``; data already over the copies is taken as it is)."""
         if vertices is None:
             return self._V if self._copy is None else self._V[self._copy]
-        X = np.asarray(vertices, dtype=np.float64)
-        if self._copy is not None and X.ndim in (1, 2) and X.shape[0] == len(self._copy):
-            return X
-        if X.ndim not in (1, 2) or X.shape[0] != len(self._V):
+        X = np.asarray(vertices)
+        if X.dtype == object or not (np.issubdtype(X.dtype, np.floating) or np.issubdtype(X.dtype, np.integer)):
+            raise TypeError(f"vertices must be a real numeric array, got dtype {X.dtype}")
+        X = X.astype(np.float64, copy=False)
+        over_copies = self._copy is not None and X.ndim in (1, 2) and X.shape[0] == len(self._copy)
+        if not over_copies and (X.ndim not in (1, 2) or X.shape[0] != len(self._V)):
             raise ValueError(f"vertices must have {len(self._V)} rows (the control mesh's), got shape "
                              f"{X.shape}")
-        return X if self._copy is None else X[self._copy]
+        if not np.isfinite(X).all():
+            bad = ~np.isfinite(X.reshape(len(X), -1)).all(axis=1)
+            i = int(np.flatnonzero(bad)[0])
+            raise MeshError(f"vertex {i} has a non-finite value {X[i].tolist()} ({int(bad.sum())} such vertices)")
+        return X if over_copies or self._copy is None else X[self._copy]
 
     def _seed_setup(self):
         """The limit points of two refined levels and where they lie (computed once)."""

@@ -101,13 +101,15 @@ class StartKeys:
         return self.key[faces]
 
 
-def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool):
+def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool, vertex_stop: bool):
     """Every point down to its depth (``depth``, one per point or one for all), or to the
-    first regular Loop patch (with ``stop_regular``). Returns the keys met (q, max depth + 1),
-    the candidates chosen (q, max depth), the level each point stopped at, and its barycentric
-    coordinates there with their derivatives in (u, v) (``bary``, ``grad`` updated in place).
-    The walk goes as far as the table knows the way; keys and child patches met for the first
-    time are refined in a batch, and the walk goes on."""
+    first regular Loop patch (with ``stop_regular``), or (with ``vertex_stop``) to the first
+    level where it is a vertex. Returns the keys met (q, max depth + 1), the candidates chosen
+    (q, max depth), the level each point stopped at, and its barycentric coordinates there
+    with their derivatives in (u, v) (``bary``, ``grad`` updated in place), and the first
+    level where it is a vertex (−1: none). The walk goes as far as the table knows the way;
+    keys and child patches met for the first time are refined in a batch, and the walk goes
+    on."""
     q = len(keys0)
     depth = np.array(np.broadcast_to(depth, (q,)), np.int64)  # contiguous: the kernel's one type
     top = int(depth.max()) if q else 0
@@ -117,11 +119,13 @@ def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool):
     keys[:, 0] = keys0
     level = np.zeros(q, np.int64)
     state = np.zeros(q, np.int8)
+    at_vertex = np.full(q, -1, np.int64)
     todo = np.arange(q)
     while len(todo):
         kernel = walk_known if _threaded(len(todo)) else walk_known_serial
         kernel(todo, level, state, keys, path, stop, bary, grad, table.cand_start.a, table.cand_count.a, table.M.a,
-               table.child.a, table.regular.a, stop_regular, depth)
+               table.child.a, table.regular.a, stop_regular, depth, at_vertex, vertex_stop,
+               2 if table.scheme == "sqrt3" else 1)
         todo = todo[state[todo] != 0]
         steps = todo[state[todo] == 2]
         if len(steps):
@@ -129,14 +133,18 @@ def _descend(table: PatchTable, keys0, bary, grad, depth, stop_regular: bool):
         cut = todo[state[todo] == 1]
         if len(cut):
             table.fill_children(np.unique(path[cut, level[cut]]))
-    return keys, path, stop, bary, grad
+    return keys, path, stop, bary, grad, at_vertex
 
 
-def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool):
+def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool,
+                  vertex_stop: bool = False):
     """The walk down (:func:`_descend`) and each point's weights on its last patch: the
-    arguments of :func:`._carry_kernels.back_rows` before its output."""
+    arguments of :func:`._carry_kernels.back_rows` before its output; then the points that
+    were a vertex of a level before their last (to be given the value of a walk stopped
+    there, :func:`_at_vertices`)."""
     q = len(keys0)
-    keys, path, stop, bary, grad = _descend(table, keys0, bary.copy(), grad.copy(), depth, stop_regular)
+    keys, path, stop, bary, grad, at_vertex = _descend(table, keys0, bary.copy(), grad.copy(), depth, stop_regular,
+                                                       vertex_stop)
     last = keys[np.arange(q), stop]
     poly = table.regular_keys(last) if stop_regular else np.zeros(q, bool)
     W = np.empty((q, n_rows, 15))  # the kernels read a point's first slots[q] weights only
@@ -159,18 +167,32 @@ def _last_weights(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop
         stencil_points(rec, bary[st], grad[st], table.st_inv.a, table.st_full.a, table.st_node.a, Ws)
         W[st, :, :6] = Ws
         block[st] = table.st_blk.a[rec]
-    return (W, np.where(poly, 15, 6), block, stop, path, keys, table.nv.a, table.blk_v0.a, table.blk_c0.a,
+    args = (W, np.where(poly, 15, 6), block, stop, path, keys, table.nv.a, table.blk_v0.a, table.blk_c0.a,
             table.blk_nc.a, table.blk_col.a, table.blk_val.a, table.t_start.a, table.t_end.a, table.t_row.a,
             table.t_col.a, table.t_val.a)
+    return args, np.flatnonzero((at_vertex >= 0) & (at_vertex < stop))
 
 
 def walk(table: PatchTable, keys0, bary, grad, n_rows: int, depth, stop_regular: bool):
     """Rows (q, nv_max, n_rows) of the points over their first patches' canonical vertices:
-    value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v²."""
-    args = _last_weights(table, keys0, bary, grad, n_rows, depth, stop_regular)
+    value, then ∂/∂u, ∂/∂v, then ∂²/∂u², ∂²/∂u∂v, ∂²/∂v². A point that is a vertex of some
+    level takes that vertex's limit position (:func:`_at_vertices`); its derivatives come
+    from the walk to its depth."""
+    args, at = _last_weights(table, keys0, bary, grad, n_rows, depth, stop_regular, n_rows == 1)
     out = np.zeros((len(keys0), int(table.nv.a[keys0].max()) if len(keys0) else 0, n_rows))
     back_rows(*args, out)
+    if len(at):
+        value, _ = _last_weights(table, keys0[at], bary[at], grad[at], 1, _pick(depth, at), stop_regular, True)
+        part = np.zeros((len(at), out.shape[1], 1))
+        back_rows(*value, part)
+        out[at, :, 0] = part[:, :, 0]
     return out
+
+
+def _pick(depth, idx: np.ndarray):
+    """``depth`` (one per point or one for all) of the points ``idx``."""
+    d = np.asarray(depth)
+    return d[idx] if d.ndim else d
 
 
 def fill_polynomials(table: PatchTable, keys: np.ndarray):
@@ -256,15 +278,22 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         keys0 = starts.of(f[rest])
         by_key = np.argsort(keys0, kind="stable")  # points on one patch together: the tables they read stay cached
         rest, keys0 = rest[by_key], keys0[by_key]
-        args = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
-                             table.regular_stop)
+        args, at = _last_weights(table, keys0, b[rest], _unit_gradients(len(rest)), n_rows, depth[rest],
+                                 table.regular_stop, n_rows == 1)
         base = starts.v0[f[rest]]
+        if len(at):  # a vertex of a level before the last: that vertex's limit position (see walk)
+            value, _ = _last_weights(table, keys0[at], b[rest[at]], _unit_gradients(len(at)), 1, depth[rest[at]],
+                                     table.regular_stop, True)
+            vals = np.zeros((1, len(at), X.shape[1]))
+            _carry_back(value, base[at], starts, X, vals, np.arange(len(at)))
         stop = args[3]
         deep = np.zeros(len(rest), bool)
         if n_rows > 1:
             deep = stop > np.where(np.asarray(starts.inp.face_sharp)[f[rest]], *FORWARD_LEVELS)
         if not deep.any():
             _carry_back(args, base, starts, X, res, rest)  # evaluation_matrix(...) @ X, to the bit
+            if len(at):
+                res[0, rest[at]] = vals[0]
             return res
         shallow, deep = np.flatnonzero(~deep), np.flatnonzero(deep)
         if len(shallow):
@@ -276,6 +305,8 @@ def walk_points(table: PatchTable, starts: StartKeys, f: np.ndarray, b: np.ndarr
         kernel = forward_points if _threaded(len(deep)) else forward_points_serial
         kernel(W, *per_point, base[deep], starts.vids.a, X, out, 1)
         res[1:, rest[deep]] = out[1:]
+        if len(at):
+            res[0, rest[at]] = vals[0]
     return res
 
 

@@ -31,11 +31,24 @@ from ._halfedge_kernels import edge_sharpness, owned_ends_in
 
 
 @kernel(inline="always")
-def _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd):
-    """The kind of edge ``h`` (twin ``t``, sharpness ``s``) this step."""
+def _boundary_halfedges(f, twin):
+    """How many of face ``f``'s halfedges are on the boundary."""
+    k = 0
+    for i in range(3):
+        if twin[3 * f + i] < 0:
+            k += 1
+    return k
+
+
+@kernel(inline="always")
+def _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd, twin):
+    """The kind of edge ``h`` (twin ``t``, sharpness ``s``) this step. Kobbelt's even steps
+    trisect the boundary edge of a face with one; a face with two or three (never met by a
+    call, which starts with an odd step, but met where the limit surface cuts a patch out of
+    a level) keeps them, as in an odd step (``docs/scheme.md``)."""
     if sqrt3:
         if t < 0:
-            return EDGE_KEEP if odd else EDGE_TRISECT
+            return EDGE_KEEP if odd or _boundary_halfedges(h // 3, twin) > 1 else EDGE_TRISECT
         return EDGE_FLIP
     if (s > 0.0 or face_sharp[h // 3] or (t >= 0 and face_sharp[t // 3])
             or (force_split.shape[0] > 0 and force_split[h])):
@@ -59,7 +72,7 @@ def _face_has_point(f, twin, face_sharp, sqrt3, odd):
     if not sqrt3:
         return not face_sharp[f], -1
     tri = -1
-    if not odd:
+    if not odd and _boundary_halfedges(f, twin) == 1:
         for i in range(3):
             if twin[3 * f + i] < 0:
                 tri = i
@@ -108,7 +121,7 @@ def classify_step(F, twin, hsharp, has_tags, face_sharp, mixed, force_split, sch
                 edge_point[h] = edge_point[t]
                 continue
             s = edge_sharpness(h, twin, hsharp, has_tags)
-            k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
+            k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd, twin)
             hkind[h] = k
             new = _new_on_edge(k)
             edge_point[h] = nxt if new else -1
@@ -156,7 +169,7 @@ def classify_step_chunks(F, twin, hsharp, has_tags, face_sharp, mixed, force_spl
                 t = twin[h]
                 if t < 0 or t > h:
                     s = edge_sharpness(h, twin, hsharp, has_tags)
-                    k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd)
+                    k = _edge_kind(h, t, s, face_sharp, force_split, sqrt3, odd, twin)
                     hkind[h] = k
                     if t >= 0:
                         hkind[t] = k
