@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._input import as_sharp_edges, open_gate
-from ._refiner import Refinement, sharpness_steps
+from ._refiner import CodedStencils, Refinement, apply_coded, apply_matrix, coded_stencils, in_read_order, sharpness_steps
 
 __all__ = ["Subdivide", "sparse", "subdivide"]
 
@@ -77,12 +77,11 @@ def sparse(M, *, dtype: torch.dtype = torch.float64, device=None) -> torch.Tenso
         raise TypeError(f"sparse takes a 2-D SciPy sparse matrix, got {type(M).__name__}")
     if dtype not in FLOATS:
         raise TypeError(f"dtype must be torch.float32 or torch.float64, got {dtype}")
-    C = sp.csr_matrix(M)
-    if not np.isrealobj(C.data):
-        raise TypeError(f"sparse takes a real matrix, got dtype {C.data.dtype}")
+    if not (np.issubdtype(M.dtype, np.floating) or np.issubdtype(M.dtype, np.integer)):
+        raise TypeError(f"sparse takes a real matrix, got dtype {M.dtype}")
+    C = sp.csr_matrix(M, copy=True)  # never the caller's arrays: sorting them would change its sums
+    C.sum_duplicates()  # columns sorted in each row, as PyTorch's CSR expects
     index = np.int32 if max(C.shape[0], C.shape[1], C.nnz) < _INT32_MAX else np.int64
-    C = sp.csr_matrix((C.data, C.indices, C.indptr), shape=C.shape)  # a copy: indices of our own
-    C.sum_duplicates()
     with warnings.catch_warnings():  # "Sparse CSR tensor support is in beta state": known, and used as documented
         warnings.filterwarnings("ignore", message="Sparse CSR tensor support is in beta", category=UserWarning)
         return torch.sparse_csr_tensor(torch.from_numpy(C.indptr.astype(index)),
@@ -91,16 +90,58 @@ def sparse(M, *, dtype: torch.dtype = torch.float64, device=None) -> torch.Tenso
                                        device=device, check_invariants=False)
 
 
+def _use_kernels(device: torch.device) -> bool:
+    """Whether data on ``device`` is multiplied by the library's kernels (the CPU) rather than
+    by PyTorch's sparse products (the tests run both on the CPU)."""
+    return device.type == "cpu"
+
+
+class _Kernels:
+    """Matrices applied one after the other on the CPU by the library's own kernels (those of
+    ``Refinement.apply``: coded stencils where the weights allow, else the threaded CSR
+    product), in float64 as ``apply`` computes, the result in the data's dtype."""
+
+    def __init__(self, mats: list):
+        self.mats = mats
+
+    def __call__(self, X: torch.Tensor) -> torch.Tensor:
+        A = X.detach().to(torch.float64).contiguous().numpy()  # a view where X is float64 already
+        for S in self.mats:
+            A = apply_coded(S, A) if isinstance(S, CodedStencils) else apply_matrix(S, A)
+        return torch.from_numpy(A).to(X.dtype)
+
+
+class _Products:
+    """Torch sparse CSR matrices applied one after the other (any device)."""
+
+    def __init__(self, mats: list):
+        self.mats = mats
+
+    def __call__(self, X: torch.Tensor) -> torch.Tensor:
+        for S in self.mats:
+            X = S @ X
+        return X
+
+
+def _kernel_chains(mats: list[sp.csr_matrix], coded: bool) -> tuple[_Kernels, _Kernels]:
+    """The CPU forward (``S_L ⋯ S_1``) and backward (``S_1ᵀ ⋯ S_Lᵀ``) of a chain; ``coded``:
+    with the weights coded (worth it for data applied many times), levels in read order."""
+    if not coded:
+        return _Kernels(mats), _Kernels([sp.csr_matrix(S.T) for S in reversed(mats)])
+    forward = in_read_order(mats)
+    backward = in_read_order([sp.csr_matrix(S.T) for S in reversed(mats)])
+    return (_Kernels([coded_stencils(S) or S for S in forward]),
+            _Kernels([coded_stencils(S) or S for S in backward]))
+
+
 class _Chain(torch.autograd.Function):
-    """``X ↦ S_L ⋯ S_1 X``, backward ``G ↦ S_1ᵀ ⋯ S_Lᵀ G`` (itself a ``_Chain``, so twice
-    differentiable)."""
+    """``X ↦ forward(X)``, backward ``G ↦ backward(G)`` (itself a ``_Chain``, so twice
+    differentiable); ``forward`` and ``backward`` apply a chain of matrices and its transpose."""
 
     @staticmethod
     def forward(ctx, X, forward, backward):
         ctx.chain = (forward, backward)
-        for S in forward:
-            X = S @ X
-        return X
+        return forward(X)
 
     @staticmethod
     def backward(ctx, G):
@@ -112,9 +153,12 @@ class Subdivide(torch.nn.Module):
     """A refinement as a differentiable layer: ``forward(X)`` is ``r.apply(X)``.
 
     The step matrices (or the given matrix) and their transposes are the module's buffers
-    (not saved in its ``state_dict``): ``.to(device)`` moves them, ``.float()`` casts them.
-    Data of the other float dtype is multiplied by a cast copy, made once per dtype and
-    device. The backward pass multiplies by the transposes (a custom autograd function), so
+    (torch sparse CSR, not saved in its ``state_dict``): ``.to(device)`` moves them,
+    ``.float()`` casts them, and on a GPU the products are PyTorch's; data of the other float
+    dtype is multiplied by a cast copy, made once per dtype and device. On the CPU the module
+    multiplies with the library's own kernels instead, those of ``r.apply`` (in float64, the
+    result in the data's dtype): the same sums and speed, forward and backward. The backward
+    pass multiplies by the transposes (a custom autograd function), so
     ``torch.autograd.gradcheck`` and second derivatives pass.
 
     Parameters
@@ -162,23 +206,29 @@ class Subdivide(torch.nn.Module):
         for i, S in enumerate(mats):
             self.register_buffer(f"S{i}", sparse(S, dtype=dtype), persistent=False)
             self.register_buffer(f"ST{i}", sparse(S.T, dtype=dtype), persistent=False)
+        self._mats = mats
         self._casts: dict = {}
+        self._kernels: tuple | None = None
 
     def _apply(self, fn, *args, **kwargs):  # .to(), .cuda(), .float(), ...: the casts are stale
         self._casts = {}
         return super()._apply(fn, *args, **kwargs)
 
-    def _chain(self, dtype: torch.dtype, device: torch.device) -> tuple[list, list]:
+    def _chain(self, dtype: torch.dtype, device: torch.device) -> tuple:
         forward = [getattr(self, f"S{i}") for i in range(self.n_steps)]
-        backward = [getattr(self, f"ST{i}") for i in reversed(range(self.n_steps))]
         if forward[0].device != device:
             raise ValueError(f"the data is on {device} and this Subdivide on {forward[0].device}: "
                              f"move one, e.g. sub.to({str(device)!r})")
-        if forward[0].dtype == dtype:
-            return forward, backward
-        if dtype not in self._casts:
-            self._casts[dtype] = ([S.to(dtype) for S in forward], [S.to(dtype) for S in backward])
-        return self._casts[dtype]
+        if _use_kernels(device):  # the library's kernels: r.apply's speed and sums
+            if self._kernels is None:
+                self._kernels = _kernel_chains(self._mats, coded=True)
+            return self._kernels
+        backward = [getattr(self, f"ST{i}") for i in reversed(range(self.n_steps))]
+        if forward[0].dtype != dtype:
+            if dtype not in self._casts:
+                self._casts[dtype] = ([S.to(dtype) for S in forward], [S.to(dtype) for S in backward])
+            forward, backward = self._casts[dtype]
+        return _Products(forward), _Products(backward)
 
     def forward(self, X: torch.Tensor) -> torch.Tensor:
         """``S @ X`` for (n_in, c) data, or each frame of (B, n_in, c) data: (n_out, c) or
@@ -214,6 +264,18 @@ def _batched(X: torch.Tensor, f) -> torch.Tensor:
     return Y.reshape(Y.shape[0], B, c).transpose(0, 1)
 
 
+class _Sequence:
+    """Operators applied one after the other."""
+
+    def __init__(self, ops: list):
+        self.ops = ops
+
+    def __call__(self, X: torch.Tensor) -> torch.Tensor:
+        for op in self.ops:
+            X = op(X)
+        return X
+
+
 def _indices(x, name: str):
     """An integer tensor as NumPy (the rest as it is: the gate checks it)."""
     if isinstance(x, torch.Tensor):
@@ -224,15 +286,16 @@ def _indices(x, name: str):
 
 
 class _SharpChain(torch.autograd.Function):
-    """``(X, s) ↦ S_L(s) ⋯ S_1(s) X``: backward in ``X`` by the transposes, in ``s`` by each
-    step's slopes (:func:`hybridsub._refiner.sharpness_steps`) between the level before and
-    the gradient after it."""
+    """``(X, s) ↦ S_L(s) ⋯ S_1(s) X`` (``forward``, ``backward``: each step's product and its
+    transpose's): backward in ``X`` by the transposes, in ``s`` by each step's slopes
+    (:func:`hybridsub._refiner.sharpness_steps`) between the level before and the gradient
+    after it."""
 
     @staticmethod
     def forward(ctx, X, s, forward, backward, slopes):
         levels = [X]
         for S in forward:
-            levels.append(S @ levels[-1])
+            levels.append(S(levels[-1]))
         ctx.state = (levels[:-1], backward, slopes)
         ctx.sharp = (s.shape[0], s.dtype)
         return levels[-1]
@@ -248,7 +311,7 @@ class _SharpChain(torch.autograd.Function):
             if ds is not None:
                 row, col, value, edge = slopes[k]
                 ds.index_add_(0, edge, value * (G[row] * levels[k][col]).sum(1))
-            G = backward[len(levels) - 1 - k] @ G
+            G = backward[len(levels) - 1 - k](G)
         return G, None if ds is None else ds.to(ctx.sharp[1]), None, None, None
 
 
@@ -319,13 +382,17 @@ def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor |
     pairs, s_norm = as_sharp_edges(sharp_edges, s_np, n)
     steps = sharpness_steps(inp, pairs, s_norm, slopes=want_s)
     dtype, device = V.dtype, V.device
-    forward = [sparse(S, dtype=dtype, device=device) for S in steps.matrices]
-    backward = [sparse(S.T, dtype=dtype, device=device) for S in reversed(steps.matrices)]
     F2 = torch.as_tensor(steps.faces, dtype=torch.int64, device=device)
-    if not forward:  # levels=0
+    if not steps.matrices:  # levels=0
         return V.clone(), F2
+    if _use_kernels(device):
+        forward = [_Kernels([S]) for S in steps.matrices]
+        backward = [_Kernels([sp.csr_matrix(S.T)]) for S in reversed(steps.matrices)]
+    else:
+        forward = [_Products([sparse(S, dtype=dtype, device=device)]) for S in steps.matrices]
+        backward = [_Products([sparse(S.T, dtype=dtype, device=device)]) for S in reversed(steps.matrices)]
     if not want_s:
-        return _batched(V, lambda Y: _Chain.apply(Y, forward, backward)), F2
+        return _batched(V, lambda Y: _Chain.apply(Y, _Sequence(forward), _Sequence(backward))), F2
     slopes = [(torch.as_tensor(q.row, device=device), torch.as_tensor(q.col, device=device),
                torch.as_tensor(q.value, dtype=dtype, device=device), torch.as_tensor(q.edge, device=device))
               for q in steps.slopes]

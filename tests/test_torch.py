@@ -24,6 +24,15 @@ def creased(name, k, seed):
     return V, F, level.edge_vertices[pick]
 
 
+@pytest.fixture(params=["kernels", "torch"])
+def path(request, monkeypatch):
+    """Both ways of multiplying: the library's kernels (the CPU's) and PyTorch's sparse
+    products (a GPU's), the latter here on the CPU."""
+    if request.param == "torch":
+        monkeypatch.setattr(ht, "_use_kernels", lambda device: False)
+    return request.param
+
+
 @pytest.fixture(scope="module")
 def fandisk():
     V, F = hybridsub.load_example()
@@ -32,7 +41,7 @@ def fandisk():
 
 
 @pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
-def test_forward_equals_apply(fandisk, scheme):
+def test_forward_equals_apply(fandisk, scheme, path):
     V, F, feat = fandisk
     tags = {} if scheme == "sqrt3" else dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
     r = hybridsub.refine(F, levels=2, scheme=scheme, **tags)
@@ -40,13 +49,27 @@ def test_forward_equals_apply(fandisk, scheme):
     sub = ht.Subdivide(r)
     got = sub(torch.tensor(V))
     assert got.dtype == torch.float64 and got.shape == want.shape
+    if path == "kernels":  # r.apply's own sums
+        assert np.array_equal(got.numpy(), want)
     assert np.abs(got.numpy() - want).max() <= 1e-12 * np.abs(want).max()
     got32 = sub(torch.tensor(V, dtype=torch.float32))
     assert got32.dtype == torch.float32
     np.testing.assert_allclose(got32.numpy(), want, rtol=0, atol=4 * np.finfo(np.float32).eps * np.abs(V).max())
 
 
-def test_batched_equals_looped(fandisk):
+def test_input_matrices_untouched(fandisk):
+    V, F, feat = fandisk
+    r = hybridsub.refine(F, feat.sharp_edges, levels=2)
+    before = [(S.matrix.indices.copy(), S.matrix.data.copy()) for S in r.steps]
+    want = r.apply(V)
+    ht.Subdivide(r)(torch.tensor(V))
+    ht.sparse(r.steps[0].matrix)
+    for S, (indices, data) in zip(r.steps, before):
+        assert np.array_equal(S.matrix.indices, indices) and np.array_equal(S.matrix.data, data)
+    assert np.array_equal(r.apply(V), want)
+
+
+def test_batched_equals_looped(fandisk, path):
     V, F, feat = fandisk
     sub = ht.Subdivide(hybridsub.refine(F, feat.sharp_edges, levels=1))
     X = torch.tensor(np.stack([V, 2 * V + 1, V[::-1].copy()]), requires_grad=True)
@@ -61,7 +84,7 @@ def test_batched_equals_looped(fandisk):
     torch.testing.assert_close(X.grad[1], X1.grad, rtol=0, atol=1e-13)
 
 
-def test_backward_is_transpose_product(fandisk):
+def test_backward_is_transpose_product(fandisk, path):
     V, F, feat = fandisk
     r = hybridsub.refine(F, feat.sharp_edges, levels=2, corners=feat.corners)
     G = np.random.default_rng(2).standard_normal((r.n_vertices, 3))
@@ -71,7 +94,7 @@ def test_backward_is_transpose_product(fandisk):
     assert np.abs(X.grad.numpy() - want).max() <= 1e-12 * np.abs(want).max()
 
 
-def test_gradcheck_and_second_derivatives():
+def test_gradcheck_and_second_derivatives(path):
     V, F, E = creased("octahedron", 3, 0)
     sub = ht.Subdivide(hybridsub.refine(F, E, levels=2, sharpness=[0.5, 2, np.inf]))
     X = torch.tensor(V, requires_grad=True)
@@ -81,7 +104,7 @@ def test_gradcheck_and_second_derivatives():
     assert torch.autograd.gradcheck(sub, (Xb,))
 
 
-def test_module_buffers_and_dtype():
+def test_module_buffers_and_dtype(path):
     V, F = load_mesh("tetrahedron")
     r = hybridsub.refine(F, levels=1, scheme="loop")
     sub = ht.Subdivide(r)
@@ -113,7 +136,7 @@ def test_limit_rows(fandisk):
 
 
 @pytest.mark.parametrize("scheme", ["hybrid", "loop"])
-def test_subdivide_equals_numpy(fandisk, scheme):
+def test_subdivide_equals_numpy(fandisk, scheme, path):
     V, F, feat = fandisk
     s = np.random.default_rng(3).uniform(0.2, 3, len(feat.sharp_edges))
     want, F2 = hybridsub.subdivide(V, F, feat.sharp_edges, levels=2, scheme=scheme, sharpness=s)
@@ -162,7 +185,7 @@ def test_sharpness_gradient_against_finite_differences(scheme, mesh):
     assert st.grad[3] == 0
 
 
-def test_sharpness_gradcheck_and_zero_cases():
+def test_sharpness_gradcheck_and_zero_cases(path):
     V, F, E = creased("icosahedron", 6, 6)
     for scheme in ("loop", "hybrid"):
         def f(X, s):
@@ -177,7 +200,7 @@ def test_sharpness_gradcheck_and_zero_cases():
     assert s.grad[:4].tolist() == [0, 0, 0, 0] and (s.grad[4:] != 0).all()
 
 
-def test_sharpness_batched_and_duplicates():
+def test_sharpness_batched_and_duplicates(path):
     V, F, E = creased("icosahedron", 4, 7)
     s = torch.tensor([0.5, 1.5, 0.25, 2.5], dtype=torch.float64, requires_grad=True)
     X = torch.tensor(np.stack([V, 3 * V]))
