@@ -42,7 +42,8 @@ def _chain(source) -> list[sp.csr_matrix]:
         return [st.matrix for st in source.steps] or [sp.identity(source.n_coarse, format="csr")]
     if sp.issparse(source) and source.ndim == 2:
         return [sp.csr_matrix(source)]
-    raise TypeError(f"subdivide_fn takes a hybridsub.Refinement or a 2-D SciPy sparse matrix, got {type(source).__name__}")
+    raise TypeError("subdivide_fn takes a hybridsub.Refinement or a 2-D SciPy sparse matrix, "
+                    f"got {type(source).__name__}")
 
 
 def subdivide_fn(source) -> Callable:

@@ -33,7 +33,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._input import as_sharp_edges, open_gate
-from ._refiner import CodedStencils, Refinement, apply_coded, apply_matrix, coded_stencils, in_read_order, sharpness_steps
+from ._refiner import (CodedStencils, Refinement, apply_coded, apply_matrix, coded_stencils, in_read_order,
+                       sharpness_steps)
 
 __all__ = ["Subdivide", "sparse", "subdivide"]
 
@@ -123,11 +124,10 @@ class _Products:
         return X
 
 
-def _kernel_chains(mats: list[sp.csr_matrix], coded: bool) -> tuple[_Kernels, _Kernels]:
-    """The CPU forward (``S_L ⋯ S_1``) and backward (``S_1ᵀ ⋯ S_Lᵀ``) of a chain; ``coded``:
-    with the weights coded (worth it for data applied many times), levels in read order."""
-    if not coded:
-        return _Kernels(mats), _Kernels([sp.csr_matrix(S.T) for S in reversed(mats)])
+def _kernel_chains(mats: list[sp.csr_matrix]) -> tuple[_Kernels, _Kernels]:
+    """The CPU forward (``S_L ⋯ S_1``) and backward (``S_1ᵀ ⋯ S_Lᵀ``) of a chain, as
+    ``r.apply`` holds its steps from the second call on: the weights coded, each level
+    between two numbered in the order the next product reads it."""
     forward = in_read_order(mats)
     backward = in_read_order([sp.csr_matrix(S.T) for S in reversed(mats)])
     return (_Kernels([coded_stencils(S) or S for S in forward]),
@@ -221,7 +221,7 @@ class Subdivide(torch.nn.Module):
                              f"move one, e.g. sub.to({str(device)!r})")
         if _use_kernels(device):  # the library's kernels: r.apply's speed and sums
             if self._kernels is None:
-                self._kernels = _kernel_chains(self._mats, coded=True)
+                self._kernels = _kernel_chains(self._mats)
             return self._kernels
         backward = [getattr(self, f"ST{i}") for i in reversed(range(self.n_steps))]
         if forward[0].dtype != dtype:

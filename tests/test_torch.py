@@ -266,3 +266,15 @@ def test_cuda_equals_cpu(fandisk):
     V2, _ = ht.subdivide(X, F, feat.sharp_edges, sharpness=s, levels=2)
     V2.sum().backward()
     assert s.grad.device.type == "cuda"
+
+
+@pytest.mark.slow  # the docs' figure script, quick mode: ~10 s
+def test_figure_script(tmp_path):
+    import importlib.util
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "docs", "figures", "differentiable.py")
+    spec = importlib.util.spec_from_file_location("differentiable_figure", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.main(["--out", str(tmp_path), "--quick"])
+    assert (tmp_path / "differentiable.png").stat().st_size > 10_000
