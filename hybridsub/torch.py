@@ -241,7 +241,7 @@ class Subdivide(torch.nn.Module):
         return f"n_in={self.n_in}, n_out={self.n_out}, steps={self.n_steps}"
 
 
-def _data(X, n: int, name: str) -> torch.Tensor:
+def _data(X, n: int | None, name: str) -> torch.Tensor:
     """``X`` checked: a float32 or float64 tensor of shape (n, c) or (B, n, c)."""
     if not isinstance(X, torch.Tensor):
         hint = f" (torch.from_numpy({name}) makes one)" if isinstance(X, np.ndarray) else ""
@@ -250,8 +250,9 @@ def _data(X, n: int, name: str) -> torch.Tensor:
         raise TypeError(f"{name} must be float32 or float64, got {X.dtype} ({name}.double() converts)")
     if X.layout != torch.strided:
         raise TypeError(f"{name} must be a dense tensor, got layout {X.layout}")
-    if X.dim() not in (2, 3) or X.shape[-2] != n:
-        raise ValueError(f"{name} must have shape ({n}, c) or (B, {n}, c), got {tuple(X.shape)}")
+    if X.dim() not in (2, 3) or (n is not None and X.shape[-2] != n):
+        k = "n" if n is None else n
+        raise ValueError(f"{name} must have shape ({k}, c) or (B, {k}, c), got {tuple(X.shape)}")
     return X
 
 
@@ -297,7 +298,7 @@ class _SharpChain(torch.autograd.Function):
         for S in forward:
             levels.append(S(levels[-1]))
         ctx.state = (levels[:-1], backward, slopes)
-        ctx.sharp = (s.shape[0], s.dtype)
+        ctx.sharp = (s.shape[0], s.dtype, s.device)
         return levels[-1]
 
     @staticmethod
@@ -312,7 +313,7 @@ class _SharpChain(torch.autograd.Function):
                 row, col, value, edge = slopes[k]
                 ds.index_add_(0, edge, value * (G[row] * levels[k][col]).sum(1))
             G = backward[len(levels) - 1 - k](G)
-        return G, None if ds is None else ds.to(ctx.sharp[1]), None, None, None
+        return G, None if ds is None else ds.to(dtype=ctx.sharp[1], device=ctx.sharp[2]), None, None, None
 
 
 def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor | None = None, levels: int = 1,
@@ -362,10 +363,8 @@ def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor |
     >>> s.grad.shape, F2.shape
     (torch.Size([722]), torch.Size([207136, 3]))
     """
-    if not isinstance(V, torch.Tensor):
-        _data(V, 0, "V")
-    n = V.shape[-2] if V.dim() >= 2 else -1
-    V = _data(V, n, "V")
+    V = _data(V, None, "V")
+    n = V.shape[-2]
     if sharpness is not None:
         if not isinstance(sharpness, torch.Tensor):
             raise TypeError(f"sharpness must be a torch.Tensor (it may require grad), got {type(sharpness).__name__}"

@@ -249,6 +249,8 @@ def test_bad_input():
         ht.subdivide(torch.tensor(V), torch.tensor(F, dtype=torch.float64))
     with pytest.raises(ValueError, match="sharpness must have one value per sharp edge"):
         ht.subdivide(torch.tensor(V), F, E, sharpness=torch.tensor([0.5, 1.0]))
+    with pytest.raises(ValueError, match=r"V must have shape \(n, c\) or \(B, n, c\), got \(12,\)"):
+        ht.subdivide(torch.zeros(12), F)
     with pytest.raises(hybridsub.MeshError, match="refers to a vertex outside"):
         ht.subdivide(torch.tensor(V), F, [[0, 9]])
 
