@@ -328,9 +328,9 @@ def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor |
     affinely, and a crease given with ``s`` has ``s − k`` at step ``k + 1``, so ``V2`` is
     affine in each crease's sharpness between integers: its derivative is exact, that of the
     piece ``(⌈s⌉ − 1, ⌈s⌉]`` holding ``s``, the derivative from below at an integer (where
-    the decay moves to another level; in the hybrid a crease's children stop being split
-    there, so ``V2`` may jump). It is zero for ``s > levels`` (``V2`` does not depend on it)
-    and for infinite creases; an edge with ``s = 0`` is no crease and gets 0.
+    the decay moves to another level, and ``V2`` may jump). It is zero for ``s > levels``
+    (``V2`` does not depend on it) and for infinite creases; an edge with ``s = 0`` is no
+    crease and gets 0.
 
     Parameters
     ----------
