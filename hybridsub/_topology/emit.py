@@ -90,17 +90,9 @@ def child_labels(level: Level, plan: StepPlan, labels: np.ndarray) -> np.ndarray
     ``labels`` (3m,) float64 holds ``LABEL_BASE + j`` on the halfedges of the creases to
     follow (``j`` ≥ 0 an integer, e.g. the row of the caller's crease list) and 0 elsewhere;
     the result holds ``LABEL_BASE + j − 1`` on the next level's halfedges of their split
-    children (the emission's rule for a sharpness, through the same kernel), 0 elsewhere.
-    After ``k`` steps a label reads ``j = label − LABEL_BASE + k``.
+    children, 0 elsewhere: the emission (:func:`child_level`) of a level tagged with the
+    labels as its sharpness. After ``k`` steps a label reads ``j = label − LABEL_BASE + k``.
     """
-    m = level.n_faces
-    offsets = np.empty(m + 1, np.int64)
-    first = np.empty(3 * m, np.int32)
-    K.child_offsets(plan.hkind, level.face_sharp, offsets, first)
-    total = int(offsets[m])
-    twin = np.empty(3 * total, np.int64)
-    out = np.zeros(3 * total)
-    (K.emit_topology if K.use_threads(m) else K.emit_topology_serial)(
-        level.twin, np.ascontiguousarray(labels, np.float64), True, plan.hkind, plan.face_point, plan.trisected,
-        level.face_sharp, first, twin, out, np.zeros(total, bool))
-    return out
+    tagged = Level(level.faces, level.n_vertices, level.twin, np.ascontiguousarray(labels, np.float64),
+                   level.face_sharp, level._by_origin)
+    return child_level(tagged, plan)[1].hsharp
