@@ -31,6 +31,7 @@ import scipy.sparse as sp
 
 from .._input import RefineInput
 from .._topology import LABEL_BASE, Level, StepPlan, blend_slopes, child_labels
+from .budget import Budget
 from .loop import walk
 from .stencils import step_matrix
 
@@ -58,7 +59,8 @@ class SharpnessSteps:
     slopes: list  # Slopes per step
 
 
-def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray, slopes: bool = True) -> SharpnessSteps:
+def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray,
+                    slopes: bool = True) -> SharpnessSteps:
     """Walk ``inp`` (no cut, no UVs) and differentiate each step in ``sharpness``.
 
     ``pairs`` (k, 2) and ``sharpness`` (k,) are the caller's creases as ``inp`` was opened
@@ -74,7 +76,7 @@ def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray, 
     matrices, slopes = [], []
     faces = inp.faces.copy()
     n0 = inp.n_vertices
-    for s in walk(inp):
+    for s in walk(inp, Budget(inp.levels, inp.scheme, inp.max_memory)):  # refused before step 1 if too large
         matrices.append(step_matrix(s.level, s.plan))
         if not want:
             faces = s.faces
