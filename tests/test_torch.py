@@ -232,6 +232,8 @@ def test_bad_input():
         sub(torch.zeros(3, 3))
     with pytest.raises(ValueError, match="shape"):
         sub(torch.zeros(4))
+    with pytest.raises(ValueError, match="the data is on meta and this Subdivide on cpu"):
+        sub(torch.zeros(4, 3, device="meta"))
     with pytest.raises(TypeError, match="Refinement or a 2-D SciPy sparse matrix, got ndarray"):
         ht.Subdivide(np.eye(3))
     with pytest.raises(TypeError, match="2-D SciPy sparse matrix"):
