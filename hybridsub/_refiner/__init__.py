@@ -11,10 +11,14 @@ from .chart import (EQUILATERAL, barycentric, child_shapes, glue, glue_maps, ont
 from .facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from .fastpath import LevelOutput, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data
 from .refinement import Refinement, RefinementStep, refine, refinement_of
-from .stencils import step_matrix
+from .sharpness import SharpnessSteps, Slopes, sharpness_steps
+from .stencils import (CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order,
+                       step_matrix)
 
-__all__ = ["EQUILATERAL", "FaceVaryingRefinement", "LevelOutput", "Refinement", "RefinementStep", "barycentric",
-           "cgroup_memory_limit", "child_shapes", "get_memory_limit", "glue", "glue_maps", "memory_source",
-           "onto_input_faces", "physical_memory", "plan_supports", "predict_levels", "refine", "refine_face_varying",
-           "refinement_of", "seam_edges", "set_memory_limit", "step_matrix", "subdivide", "subdivide_face_varying",
-           "subdivide_face_varying_levels", "subdivide_levels", "vertex_origins", "walk_data"]
+__all__ = ["apply_coded", "apply_matrix", "barycentric", "cgroup_memory_limit", "child_shapes", "coded_stencils",
+           "CodedStencils", "EQUILATERAL", "FaceVaryingRefinement", "get_memory_limit", "glue", "glue_maps",
+           "in_read_order", "LevelOutput", "memory_source", "onto_input_faces", "physical_memory", "plan_supports",
+           "predict_levels", "refine", "refine_face_varying", "Refinement", "refinement_of", "RefinementStep",
+           "seam_edges", "set_memory_limit", "sharpness_steps", "SharpnessSteps", "Slopes", "step_matrix",
+           "subdivide", "subdivide_face_varying", "subdivide_face_varying_levels", "subdivide_levels",
+           "vertex_origins", "walk_data"]

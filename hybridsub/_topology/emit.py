@@ -77,3 +77,22 @@ def child_creases(level: Level, plan: StepPlan):
     pairs[1::2, 0] = mid
     pairs[1::2, 1] = w
     return pairs, np.repeat(R.child_sharpness(level.hsharp[keep]), 2)
+
+
+#: Offset of the crease labels :func:`child_labels` carries: above every sharpness, so that
+#: the emission passes every label on (less one per level, as it does a sharpness).
+LABEL_BASE = 2.0**40
+
+
+def child_labels(level: Level, plan: StepPlan, labels: np.ndarray) -> np.ndarray:
+    """A per-halfedge label carried from a level's creases onto their children.
+
+    ``labels`` (3m,) float64 holds ``LABEL_BASE + j`` on the halfedges of the creases to
+    follow (``j`` ≥ 0 an integer, e.g. the row of the caller's crease list) and 0 elsewhere;
+    the result holds ``LABEL_BASE + j − 1`` on the next level's halfedges of their split
+    children, 0 elsewhere: the emission (:func:`child_level`) of a level tagged with the
+    labels as its sharpness. After ``k`` steps a label reads ``j = label − LABEL_BASE + k``.
+    """
+    tagged = Level(level.faces, level.n_vertices, level.twin, np.ascontiguousarray(labels, np.float64),
+                   level.face_sharp, level._by_origin)
+    return child_level(tagged, plan)[1].hsharp

@@ -13,6 +13,7 @@ applied to data.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -59,6 +60,38 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     Tags come from the level (``hsharp``, ``face_sharp``: all sharp for ``"loop"``, none for
     ``"sqrt3"``); ``corner`` (n,) is the corner mask.
     """
+    c = _classified(level, scheme, step, force_split)
+    coefficients = _coefficients(level, c, corner, scheme, step, loop_weights, c.s_frac)
+    if scheme == "sqrt3" and step % 2 == 0 and c.trisected.max(initial=-1) >= 0:  # boundary edges to trisect
+        bnext, bprev = K.boundary_links(level.faces, level.twin)
+    else:
+        bnext = bprev = EMPTY_INT
+    return StepPlan(scheme, step, c.hkind, c.edge_point, c.face_point, c.trisected, coefficients, c.n_new, bnext,
+                    bprev)
+
+
+def step_arguments(level: Level, plan: StepPlan) -> tuple:
+    """The arguments the stencil kernels share, in their order."""
+    has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
+    return (level.faces, level.twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, plan.hkind,
+            plan.edge_point, plan.face_point, plan.coefficients, plan.bnext, plan.bprev)
+
+
+class _Classified(NamedTuple):
+    """A step's classification: what :func:`plan_step` and :func:`blend_slopes` share."""
+
+    hkind: np.ndarray
+    edge_point: np.ndarray
+    face_point: np.ndarray
+    trisected: np.ndarray
+    counts: np.ndarray  # (6, n), see _classify_kernels.classify_step
+    s_frac: np.ndarray  # (n,) sum of the sharpness of each vertex's creases with 0 < s <= 1
+    n_new: int
+    region_of_all: int
+
+
+def _classified(level: Level, scheme: str, step: int, force_split: np.ndarray | None) -> _Classified:
+    """Edge kinds, the new points' layout and the per-vertex numbers the rules need."""
     F, twin = level.faces, level.twin
     m, n = level.n_faces, level.n_vertices
     odd = step % 2 == 1
@@ -82,23 +115,36 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     args = (F, twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, level.face_sharp, mixed, force,
             R.SCHEME_CODES[scheme], odd, hkind, edge_point, face_point, trisected, counts, s_frac)
     n_new = C.classify_step_chunks(*args, numba.get_num_threads()) if K.use_threads(m) else C.classify_step(*args)
-    table = R.smooth_weight_table(int(counts[0].max()) if n else 0, loop_weights)
+    return _Classified(hkind, edge_point, face_point, trisected, counts, s_frac, int(n_new), region_of_all)
+
+
+def _coefficients(level: Level, c: _Classified, corner: np.ndarray, scheme: str, step: int, loop_weights: str,
+                  s_frac: np.ndarray) -> np.ndarray:
+    """Every vertex mask as four coefficients, the semi-sharp blends from ``s_frac``."""
+    n = level.n_vertices
+    sqrt3 = scheme == "sqrt3"
+    table = R.smooth_weight_table(int(c.counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
-    (C.vertex_coefficients if K.use_threads(m) else C.vertex_coefficients_serial)(
-        counts, s_frac, corner, region_of_all, table, cs, cn, sqrt3 and odd, coefficients)
-    if sqrt3 and not odd and trisected.max(initial=-1) >= 0:  # boundary edges to trisect
-        bnext, bprev = K.boundary_links(F, twin)
-    else:
-        bnext = bprev = EMPTY_INT
-    return StepPlan(scheme, step, hkind, edge_point, face_point, trisected, coefficients, int(n_new), bnext,
-                    bprev)
+    (C.vertex_coefficients if K.use_threads(level.n_faces) else C.vertex_coefficients_serial)(
+        c.counts, s_frac, corner, c.region_of_all, table, cs, cn, sqrt3 and step % 2 == 1, coefficients)
+    return coefficients
 
 
-def step_arguments(level: Level, plan: StepPlan) -> tuple:
-    """The arguments the stencil kernels share, in their order."""
-    has_tags = level.hsharp is not None and plan.scheme != "sqrt3"
-    return (level.faces, level.twin, level.hsharp if has_tags else EMPTY_FLOAT, has_tags, plan.hkind,
-            plan.edge_point, plan.face_point, plan.coefficients, plan.bnext, plan.bprev)
+def blend_slopes(level: Level, corner: np.ndarray, scheme: str, step: int,
+                 loop_weights: str) -> tuple[np.ndarray, np.ndarray]:
+    """How each vertex mask of a step moves with its semi-sharp blend ``w``.
 
-
+    A vertex whose creases decay this step (``0 < s <= 1``) takes ``w · parent + (1 − w) ·
+    child`` (:func:`hybridsub._rules.step_rules.vertex_mask`), ``w`` the mean sharpness of
+    those creases: its four coefficients are affine in ``w``. Returns ``(slopes, decaying)``:
+    ``slopes`` (4, n) the coefficients' derivative in ``w`` (the masks at ``w = 1`` less those
+    at ``w = 0``; zero where nothing decays or both rules agree) and ``decaying`` (n,) the
+    number of each vertex's decaying creases, so that a vertex's mask moves by ``slopes /
+    decaying`` per unit of one of them.
+    """
+    c = _classified(level, scheme, step, None)
+    decaying = c.counts[3].copy()
+    at_one = _coefficients(level, c, corner, scheme, step, loop_weights, decaying.astype(np.float64))
+    at_zero = _coefficients(level, c, corner, scheme, step, loop_weights, np.zeros(level.n_vertices))
+    return at_one - at_zero, decaying
