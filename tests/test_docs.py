@@ -50,9 +50,9 @@ def _usage_files():
 #: What a page's shell commands made before its Python blocks, by page.
 SETUP = {"usage.md": _usage_files}
 
-#: Pages whose blocks start worker processes (a local Dask cluster) or fit surfaces to
-#: thousands of points: run with ``-m slow``.
-SLOW = {"batch.md", "fitting.md"}
+#: Pages whose blocks start worker processes (a local Dask cluster), fit surfaces to
+#: thousands of points or run 300 steps of gradient descent: run with ``-m slow``.
+SLOW = {"batch.md", "fitting.md", "differentiable.md"}
 
 
 @pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW else p

@@ -143,7 +143,7 @@ def test_feature_angle_with_cut_on_an_inconsistently_oriented_mesh():
 
 
 def test_load_example_names_the_examples():
-    with pytest.raises(ValueError, match="no example mesh named 'x'; the examples are: 'cube', 'fandisk'"):
+    with pytest.raises(ValueError, match="no example mesh named 'x'; the examples are: 'cube', 'fandisk', 'icosahedron'"):
         hybridsub.load_example("x")
 
 

@@ -13,7 +13,7 @@ def example_names() -> list[str]:
     """The names of the shipped example meshes.
 
     >>> example_names()
-    ['cube', 'fandisk']
+    ['cube', 'fandisk', 'icosahedron']
     """
     data = resources.files("hybridsub").joinpath("data")
     return sorted(p.name[:-4] for p in data.iterdir() if p.name.endswith(".off"))
@@ -21,12 +21,12 @@ def example_names() -> list[str]:
 
 def example_path(name: str = "fandisk") -> str:
     """Path of a shipped example mesh (``"fandisk"``: 6475 vertices, 12946 faces; ``"cube"``:
-    866 vertices, 1728 faces).
+    866 vertices, 1728 faces; ``"icosahedron"``: 12 vertices, 20 faces).
 
     >>> example_path("bunny")
     Traceback (most recent call last):
     ...
-    ValueError: no example mesh named 'bunny'; the examples are: 'cube', 'fandisk'
+    ValueError: no example mesh named 'bunny'; the examples are: 'cube', 'fandisk', 'icosahedron'
     """
     names = example_names()
     if name not in names:
@@ -42,7 +42,8 @@ def load_example(name: str = "fandisk") -> tuple[np.ndarray, np.ndarray]:
     name : str
         The example's name: ``"fandisk"`` (the default, 6475 vertices, 12946 faces, the CAD
         part of Hoppe et al. with 722 creases at 30°) or ``"cube"`` (866 vertices, 1728 faces:
-        a meshed CAD cube, its edges creases at 30°, small enough for quick examples).
+        a meshed CAD cube, its edges creases at 30°, small enough for quick examples) or
+        ``"icosahedron"`` (12 vertices, 20 faces, on the unit sphere).
 
     Raises
     ------
