@@ -24,6 +24,14 @@ def _default_depth(scheme: str) -> int:
     return 14 if scheme == "loop" else 18
 
 
+def _numbers(a, name: str) -> np.ndarray:
+    """``a`` as a float64 array, or a TypeError naming the argument."""
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be an array of numbers ({e})") from None
+
+
 class LimitSurface:
     """The limit surface of a control mesh, evaluated at any point of its input faces.
 
@@ -102,8 +110,12 @@ class LimitSurface:
         f = np.asarray(face)
         if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.all(f == np.round(f))):
             raise TypeError(f"face must be integers, got dtype {f.dtype}")
-        f = f.astype(np.int64).reshape(-1)
-        b = np.asarray(bary, dtype=np.float64)
+        f = f.reshape(-1)
+        big = np.flatnonzero(~(np.abs(f) < m)) if f.dtype.kind != "i" else np.zeros(0, np.int64)
+        if len(big):  # before the cast to int64, which would wrap
+            raise ValueError(f"face[{big[0]}] = {f[big[0]]} is not a face (the mesh has {m} faces)")
+        f = f.astype(np.int64)
+        b = _numbers(bary, "bary")
         if b.ndim == 1 and b.shape[0] == 3 and len(f) == 1:
             b = b[None]
         if b.ndim != 2 or b.shape != (len(f), 3):
@@ -257,7 +269,11 @@ class LimitSurface:
         X = self._V if vertices is None else as_vertices(vertices)
         if len(X) != self._inp.n_vertices:
             raise ValueError(f"vertices must have {self._inp.n_vertices} rows (the control mesh's), got {len(X)}")
-        pts = np.asarray(points, dtype=np.float64)
+        if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)):
+            raise TypeError(f"max_iter must be an integer, got {max_iter!r}")
+        if max_iter < 1:
+            raise ValueError(f"max_iter must be at least 1, got {max_iter}")
+        pts = _numbers(points, "points")
         if pts.ndim == 1 and pts.shape == (3,):
             pts = pts[None]
         if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
