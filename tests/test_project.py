@@ -108,11 +108,11 @@ def test_the_certificate_bound_holds_at_surface_points(name, scheme):
     seeds = s._seed_setup()
     centre, scale = P._frame(s.vertices, seeds)
     Xn = (s.vertices - centre) / scale
-    X = np.ascontiguousarray(seeds.matrix @ Xn)
+    state = P.level_state(seeds, Xn)
+    X, eps = state.P, state.eps
     rng = np.random.default_rng(3)
     n = 3000
     Y = np.ascontiguousarray(s.evaluate(rng.integers(0, len(s.faces), n), rng.dirichlet([1, 1, 1], n), vertices=Xn))
-    _, _, _, _, eps = P.candidates(seeds, X, seeds.limits @ Xn, Y[:1])
     faces = seeds.faces
     lo, h, dims = _grid(X, X[faces])
     start = np.zeros(int(np.prod(dims)) + 1, np.int64)

@@ -15,6 +15,7 @@ tested.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 
 import numpy as np
 import scipy.sparse as sp
@@ -32,13 +33,13 @@ from .vertex_limit import LimitSetup, _evaluate
 SEED_FACES = 30000
 MAX_LEVELS = 6
 #: Survivors gathered per point in the first pass (points with more are gathered again, with more room).
-KEEP = 32
+KEEP = 64
 #: Depth of the descent while the foot point is still far (the last iterations use the full depth).
 COARSE_DEPTH = 8
 #: The coarse iterations stop at this step size in (u, v), the fine ones at FINE_STEP.
 COARSE_STEP, FINE_STEP = 1e-7, 1e-11
 #: Seeds whose coarse foot is within this (in diagonals) of the best go on at the full depth.
-COARSE_GAP = 1e-6
+COARSE_GAP = 1e-5
 #: The longest Newton step in (u, v).
 MAX_STEP = 0.5
 #: At most this many iterations at the full depth (each costs a full descent).
@@ -243,29 +244,51 @@ def _frame(X: np.ndarray, seeds: SeedMesh):
     return centre, (diag if diag > 0 and np.isfinite(diag) else 1.0)
 
 
-def candidates(seeds: SeedMesh, P: np.ndarray, Pinf: np.ndarray, pts: np.ndarray, limit: np.ndarray | None = None):
-    """The certificate on the level's positions ``P``: for each point, the survivors' seeds.
+@dataclasses.dataclass(frozen=True, eq=False)
+class LevelState:
+    """The certificate's level at one set of control positions: its vertices ``P``, their
+    limit points ``limits``, each face's ``eps`` (ε_T) and the grid of cells over the faces."""
 
-    Returns ``(point, inface, bary, low, eps)``: one seed per point and connected component of
-    its surviving triangles (meeting across edges that are not creases; the survivor nearest
-    the point), its barycentric coordinates over that input face (in its unfolded chart), the
-    component's lower bound on the distance to the limit surface over it, and the level's
-    ``ε_T`` (for the tests).
-    """
+    key: bytes
+    P: np.ndarray
+    limits: np.ndarray
+    eps: np.ndarray
+    grid: tuple
+
+
+def level_state(seeds: SeedMesh, Xn: np.ndarray) -> LevelState:
+    """The :class:`LevelState` of the control positions ``Xn`` (in units of the diagonal)."""
+    P = np.ascontiguousarray(seeds.matrix @ Xn)
     faces = seeds.faces
     eps = np.empty(len(faces))
     ring_deviation(P, faces, seeds.ring_start, seeds.ring, eps)
-    used = np.unique(faces)
-    lo, h, dims = _grid(P[used], P[faces])
+    lo, h, dims = _grid(P, P[faces])  # (every vertex of a refined level is used)
     start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
     cell_faces = bin_faces(P, faces, lo, h, dims, start)
+    return LevelState(_key(Xn), P, np.ascontiguousarray(seeds.limits @ Xn), eps, (lo, h, dims, start, cell_faces))
+
+
+def _key(Xn: np.ndarray) -> bytes:
+    return hashlib.blake2b(np.ascontiguousarray(Xn).tobytes(), digest_size=16).digest()
+
+
+def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.ndarray | None = None):
+    """The certificate on the level at ``state``: for each point, the survivors' seeds.
+
+    Returns ``(point, inface, bary, low)``: one seed per point and connected component of
+    its surviving triangles (meeting across edges that are not creases; the survivor nearest
+    the point), its barycentric coordinates over that input face (in its unfolded chart) and
+    the component's lower bound on the distance to the limit surface over it.
+    """
+    faces, P, eps = seeds.faces, state.P, state.eps
+    lo, h, dims, start, cell_faces = state.grid
     m = len(pts)
     f0 = np.full(m, -1, np.int64)
     b0 = np.zeros((m, 3))
     d2 = np.full(m, np.inf)
     closest_in_grid(pts, P, faces, lo, h, dims, start, cell_faces, f0, b0, d2)
     # An upper bound on the distance to the surface: the limit points of the nearest face's corners.
-    bound = np.linalg.norm(pts[:, None, :] - Pinf[faces[f0]], axis=2).min(axis=1) * (1 + 1e-15) + 1e-12
+    bound = np.linalg.norm(pts[:, None, :] - state.limits[faces[f0]], axis=2).min(axis=1) * (1 + 1e-15) + 1e-12
     point, tri, lam, dist, lb = _survivors(pts, P, faces, eps, seeds.ring_start, seeds.ring, lo, h, dims, start,
                                        cell_faces, bound)
     order = np.lexsort((dist, point))
@@ -283,7 +306,7 @@ def candidates(seeds: SeedMesh, P: np.ndarray, Pinf: np.ndarray, pts: np.ndarray
         point, tri, lam, low = point[keep], tri[keep], lam[keep], low[keep]
     g = seeds.inface[tri]
     bary = np.einsum("ki,kij->kj", lam, seeds.corners[tri])
-    return point, g, bary, low, eps
+    return point, g, bary, low
 
 
 def _survivors(pts, P, faces, eps, ring_start, ring, lo, h, dims, start, cell_faces, bound):
@@ -320,10 +343,11 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     with np.errstate(over="ignore"):
         far = size / scale * length > FAR
         q = np.where(far[:, None], unit / np.where(length > 0, length, 1.0)[:, None] * FAR, diff / scale)
-    P = np.ascontiguousarray(seeds.matrix @ Xn)
+    state = surface._level_state
+    if state is None or state.key != _key(Xn):
+        state = surface._level_state = level_state(seeds, Xn)
     F0 = surface._inp.faces
-    point, sf, sb, low, _ = candidates(seeds, P, seeds.limits @ Xn, np.ascontiguousarray(q),
-                                  np.where(far, FAR_SEEDS, len(F0)))
+    point, sf, sb, low = candidates(seeds, state, np.ascontiguousarray(q), np.where(far, FAR_SEEDS, len(F0)))
     sf, sb = onto_input_faces(sf, sb, seeds.walls, F0)
     many = q[point]
     coarse = min(COARSE_DEPTH, surface.depth)

@@ -80,6 +80,7 @@ class LimitSurface:
         self._V = X.copy()
         self._V.setflags(write=False)
         self._seeds = None
+        self._level_state = None  # the certificate's level at the last control positions projected on
         if depth is None:
             depth = _default_depth(scheme)
         if isinstance(depth, bool) or int(depth) != depth or depth < 0:
