@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from .._input import RefineInput
 from .._topology import build_level
 from .._refiner import EQUILATERAL, barycentric, child_shapes, matrix_supports, onto_input_faces, refinement_of
-from ._closest_kernels import (bin_faces, closest_in_grid, face_rings, faces_within, ring_deviation,
+from ._closest_kernels import (bin_faces, closest_among, closest_in_grid, face_rings, faces_within, ring_deviation,
                                survivor_components)
 from .mask_plan import edge_sharpness
 from .mesh_closest import _grid
@@ -36,8 +36,9 @@ MAX_LEVELS = 6
 KEEP = 64
 #: Depth of the descent while the foot point is still far (the last iterations use the full depth).
 COARSE_DEPTH = 8
-#: The coarse iterations stop at this step size in (u, v), the fine ones at FINE_STEP.
-COARSE_STEP, FINE_STEP = 1e-7, 1e-11
+#: The coarse iterations stop at a step this long in space (in diagonals), the fine ones at
+#: FINE_STEP (a little above the noise of a step at the full depth).
+COARSE_STEP, FINE_STEP = 1e-8, 1e-11
 #: Seeds whose coarse foot is within this (in diagonals) of the best go on at the full depth.
 COARSE_GAP = 1e-5
 #: The longest Newton step in (u, v).
@@ -180,7 +181,8 @@ def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
 
 def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=None, low=None, gap=0.0):
     """Damped Newton at one descent depth: a step that does not bring a point closer is taken
-    back and tried again four times shorter; a point stops when its step is below ``stop``.
+    back and tried again four times shorter; a point stops when its Newton step moves it less
+    than ``stop`` (in space, in units of the diagonal).
     Returns the best (face, bary) of each point, its distance, the surface point there and the
     derivatives (Du, Dv, Duu, Duv, Dvv) (k, 5, 3). With ``point`` (k,), the query each row
     belongs to, and ``low`` (k,), a lower bound on the distance each row can reach, a row stops
@@ -212,16 +214,21 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
             G[ib, j] = Dj[better]
         R[ib] = (pts[idx] - P)[better]
         Pb[ib] = P[better]
-        trust[ib] = np.minimum(1.0, 2.0 * trust[ib])
+        trust[ib] = 1.0
         trust[idx[~better]] *= 0.25
         du, dv = _newton_step(best_f[idx], best_b[idx], walls, cone[F0[best_f[idx]]], R[idx],
                               *(G[idx, j] for j in range(5)))
         size = np.hypot(du, dv)
         scale = trust[idx] * np.minimum(1.0, MAX_STEP / np.maximum(size, 1e-300))
-        du, dv = du * scale, dv * scale
-        nb = best_b[idx] + np.stack([-du - dv, du, dv], axis=1)
+        reach = np.linalg.norm(du[:, None] * G[idx, 0] + dv[:, None] * G[idx, 1], axis=1)
+        delta = np.stack([-du - dv, du, dv], axis=1) * scale[:, None]
+        # A step out through a wall of the face stops on it (the next one goes along it).
+        wall = walls[3 * best_f[idx][:, None] + (np.arange(3) + 1) % 3] < 0
+        bb = best_b[idx]
+        cut = np.where(wall & (delta < 0), bb / np.where(delta < 0, -delta, 1.0), 1.0).min(axis=1)
+        nb = bb + delta * np.minimum(cut, 1.0)[:, None]
         face[idx], bary[idx] = onto_input_faces(best_f[idx], nb, walls, F0)
-        active[idx[((size < stop) & better) | level]] = False
+        active[idx[((reach < stop) & better) | level]] = False
         active[idx[trust[idx] < 1e-12]] = False
         if point is not None:
             U = np.full(point.max() + 1, np.inf)
@@ -304,8 +311,16 @@ def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.nd
         rank = np.arange(len(point)) - np.searchsorted(point, point)
         keep = rank < limit[point]
         point, tri, lam, low = point[keep], tri[keep], lam[keep], low[keep]
-    g = seeds.inface[tri]
-    bary = np.einsum("ki,kij->kj", lam, seeds.corners[tri])
+    # The seed: the closest point of the limit points' mesh (vertices at their limit points,
+    # nearer the surface than the level) on the survivor and its neighbours this side of walls.
+    near = np.c_[tri, seeds.level_walls[3 * tri[:, None] + np.arange(3)] // 3]
+    near = -np.sort(-np.where(near >= 0, near, -1), axis=1)  # (−1 ends a row)
+    tri2 = np.full(len(tri), -1, np.int64)
+    lam2 = np.zeros((len(tri), 3))
+    closest_among(np.ascontiguousarray(pts[point]), state.limits, faces, near, tri2, lam2,
+                  np.full(len(tri), np.inf))
+    g = seeds.inface[tri2]
+    bary = np.einsum("ki,kij->kj", lam2, seeds.corners[tri2])
     return point, g, bary, low
 
 
