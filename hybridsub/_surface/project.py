@@ -156,10 +156,12 @@ _ALONG = np.array([[1.0, -1.0], [0.0, 1.0], [1.0, 0.0]])
 
 def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
     """Newton step in (u, v) on |x − P|²/2; on a wall (a crease or boundary edge of the face, the
-    point on it) a step out of the face is replaced by the step along the wall, at a corner of
+    point on it) a step out of the face is replaced by Gauss–Newton's step along the wall, at a corner of
     two walls by none, and at a corner vertex (``cone_at`` (k, 3): the face's corners that are
     tagged corners or meet three walls or more) a step on past it by none."""
     a, b, c, gu, gv = _hessian(r, Du, Dv, Duu, Duv, Dvv)
+    # Along a wall, Gauss–Newton's curvature: second derivatives mean little at creases.
+    a0, b0, c0 = (np.einsum("ij,ij->i", x, y) for x, y in ((Du, Du), (Du, Dv), (Dv, Dv)))
     det = a * c - b * b
     det = np.where(np.abs(det) > 0, det, 1.0)
     du, dv = (c * gu - b * gv) / det, (a * gv - b * gu) / det
@@ -170,7 +172,7 @@ def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
             out = on_wall[:, j] & (delta < 0)
             if out.any():
                 eu, ev = _ALONG[j]
-                curv = a * eu * eu + 2 * b * eu * ev + c * ev * ev
+                curv = a0 * eu * eu + 2 * b0 * eu * ev + c0 * ev * ev
                 t = (gu * eu + gv * ev) / np.where(curv > 0, curv, 1.0)
                 du, dv = np.where(out, t * eu, du), np.where(out, t * ev, dv)
     delta = np.stack([-du - dv, du, dv], axis=1)
@@ -203,10 +205,12 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
             break
         P, *D = surface._applied(face[idx], bary[idx], 6, depth, X)
         d = np.linalg.norm(pts[idx] - P, axis=1)
-        # At a vertex, a step that changes the distance by rounding only ends the row: it
-        # circles the vertex through the faces round it, at its foot.
+        # At a vertex or on a wall, a step that changes the distance by rounding only ends the
+        # row: it circles the vertex through the faces round it, or the derivatives along a
+        # crease (which mean little there) move it along a crease that is level to rounding.
+        edge = best_b[idx].min(axis=1) <= 1e-10
         level = (np.isfinite(best_d[idx]) & (np.abs(d - best_d[idx]) <= 1e-15 * best_d[idx])
-                 & (best_b[idx].max(axis=1) >= 1 - 1e-10))
+                 & ((best_b[idx].max(axis=1) >= 1 - 1e-10) | edge))
         better = d <= best_d[idx] * (1 + 1e-14) + 1e-15  # (the data are in units of the diagonal)
         ib = idx[better]
         best_f[ib], best_b[ib], best_d[ib] = face[ib], bary[ib], d[better]
