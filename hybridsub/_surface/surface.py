@@ -252,9 +252,12 @@ class LimitSurface:
     def project(self, points: ArrayLike, *, vertices: ArrayLike | None = None, max_iter: int = 30):
         """Closest points of the limit surface: ``(face, bary, Q, dist)``.
 
-        ``dist`` is signed: positive on the side the normals point to. Seeds come from a dense
-        sampling of the surface; Gauss–Newton on (face, u, v) then walks across face
-        boundaries to the foot point (``docs/limit.md``).
+        ``dist`` is signed: positive on the side the normals point to. The foot is the
+        closest point: a refined level whose faces bound the limit surface over them (its
+        convex hull property) rules out every region that cannot hold a nearer point, and
+        Newton on (face, u, v) runs in every region that survives, along creases and the
+        boundary where the foot lies on them (``docs/limit.md``). ``max_iter`` (an integer,
+        at least 1) bounds the iterations of each run at the coarse descent depth.
 
         Examples
         --------
