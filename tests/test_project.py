@@ -158,3 +158,14 @@ def test_bad_arguments_are_named():
         s.evaluate(np.array([2**63 + 5], dtype=np.uint64), [[1, 0, 0]])
     with pytest.raises(TypeError, match="bary"):
         s.evaluate([0], [["x", 0, 0]])
+
+
+def test_far_points_that_the_nearest_vertex_seeds_missed():
+    """Far points over the boundary of mesh_with_border (√3), where seeds at the nearest limit
+    vertices led Newton to a foot 3e-5 diagonals farther than this surface point."""
+    s = surface("mesh_with_border", "sqrt3")
+    Q = np.array([[197.59550096, 393.3469516, 68.70678532], [132.68499864, 415.55984629, 8.36832889],
+                  [157.43110174, 410.49477949, 25.77949177], [19.17056492, 354.3507636, -179.23876057],
+                  [53.55921345, 398.13558584, -104.81957861], [14.97759516, 349.22268056, -184.97871889]])
+    Y = s.evaluate([955] * len(Q), [[1.51116200e-01, 8.48404413e-01, 4.79387163e-04]] * len(Q))
+    assert_no_farther(s, Q, Y)
