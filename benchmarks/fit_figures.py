@@ -78,7 +78,7 @@ def scan_fit():
     import trimesh
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from hybridsub._fit.closest import closest_points
+    from hybridsub._surface.mesh_closest import closest_points
 
     V, F = hybridsub.load_example()
     rng = np.random.default_rng(3)

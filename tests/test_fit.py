@@ -5,8 +5,8 @@ import pytest
 
 import hybridsub
 from conftest import load_mesh
-from hybridsub._fit._closest_kernels import closest_among
-from hybridsub._fit.closest import ClosestPoints, closest_points
+from hybridsub._surface._closest_kernels import closest_among
+from hybridsub._surface.mesh_closest import ClosestPoints, closest_points
 
 
 def _control():

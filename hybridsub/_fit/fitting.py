@@ -30,9 +30,8 @@ import scipy.sparse as sp
 from .._errors import MeshError
 from .._input import as_faces, as_vertices, count_of, open_gate
 from .._typing import ArrayLike, LoopWeights, Scheme
-from ._closest_kernels import face_systems
-from .closest import ClosestPoints
-from .._surface import LimitSurface
+from ._fit_kernels import face_systems
+from .._surface import ClosestPoints, LimitSurface
 from .._refiner import refine
 
 TANGENT_WEIGHT = 1e-6       # λ near the target: the tangential damping

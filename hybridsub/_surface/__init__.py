@@ -7,10 +7,13 @@ of a level, on the sectors the topology layer cuts (``_topology.vertex_sectors``
 stars of the vertices without a stationary mask until their rows and normals settle; ``vertex_limit``
 holds the public functions. ``descent`` follows any point of the surface down the refinement
 (exact local refinement), ``surface`` is :class:`LimitSurface` on top of it, ``project`` its
-closest points. ``docs/limit.md`` explains every decision taken here.
+closest points, certified on the exact closest points of a refined level (``mesh_closest``,
+Numba kernels in ``_closest_kernels``; fitting uses them too). ``docs/limit.md`` explains every decision taken here.
 """
 
 from .vertex_limit import limit_matrix, limit_normals, limit_positions
 from .surface import LimitSurface
+from .mesh_closest import ClosestPoints, Footpoints, closest_points
 
-__all__ = ["LimitSurface", "limit_matrix", "limit_normals", "limit_positions"]
+__all__ = ["ClosestPoints", "Footpoints", "LimitSurface", "closest_points", "limit_matrix", "limit_normals",
+           "limit_positions"]

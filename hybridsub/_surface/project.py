@@ -1,38 +1,110 @@
-"""Closest points on the limit surface: seeds from the limit points of a refined level, then
-Gauss–Newton on (face, u, v), walking across face boundaries in the rhombus chart."""
+"""Closest points on the limit surface, certified by a refined level.
+
+Every rule of every scheme has non-negative weights (SCHEME.md), so the limit surface over a
+triangle T of a refined level lies in the convex hull of the level's vertices that reach it,
+and so within ``ε_T`` of T: the largest distance from T to a vertex of its ring (one ring
+of faces round T for Loop, two for √3 and the hybrid). For a query q whose closest point on
+the level is at distance d₀ on T₀, the limit surface has a point within ``d₀ + ε_T₀``; a
+triangle with ``dist(q, T) − ε_T`` above that holds no closer limit point. Every input face
+that a surviving triangle lies over gets a Newton run from the survivor's closest point
+(damped Newton on (face, u, v), across smooth edges, along creases and the boundary, which
+are walls), and the best foot wins. ``docs/limit.md`` derives the bound and says how it is
+tested.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 
 import numpy as np
+import scipy.sparse as sp
 
 from .._input import RefineInput
 from .._topology import build_level
-from .._refiner import onto_input_faces, refinement_of
-from .vertex_limit import LimitSetup, _evaluate
+from .._refiner import EQUILATERAL, barycentric, child_shapes, matrix_supports, onto_input_faces, refinement_of
+from ._closest_kernels import (bin_faces, closest_among, closest_in_grid, face_rings, faces_within, ring_deviation,
+                               survivor_components)
 from .mask_plan import edge_sharpness
+from .mesh_closest import _grid
+from .vertex_limit import LimitSetup, _evaluate
 
-#: Levels of the refined mesh whose limit points seed the search.
-SEED_LEVELS = 2
-#: Seeds per point (the nearest limit points of the seed level): far points have several local minima.
-SEEDS = 4
+#: The certificate's level: the first with at least this many faces (at least one level, at most MAX_LEVELS).
+SEED_FACES = 30000
+MAX_LEVELS = 6
+#: Survivors gathered per point in the first pass (points with more are gathered again, with more room).
+KEEP = 64
 #: Depth of the descent while the foot point is still far (the last iterations use the full depth).
 COARSE_DEPTH = 8
-#: The coarse iterations stop at this step size in (u, v), the fine ones at FINE_STEP.
-COARSE_STEP, FINE_STEP = 1e-7, 1e-11
-#: The longest Gauss–Newton step in (u, v).
+#: The coarse iterations stop at a step this long in space (in diagonals), the fine ones at
+#: FINE_STEP (a little above the noise of a step at the full depth).
+COARSE_STEP, FINE_STEP = 1e-8, 1e-11
+#: Seeds whose coarse foot is within this (in diagonals) of the best go on at the full depth.
+COARSE_GAP = 1e-5
+#: The longest Newton step in (u, v).
 MAX_STEP = 0.5
 #: At most this many iterations at the full depth (each costs a full descent).
 FINE_ITER = 12
+#: Queries farther than this (in diagonals) from the box's centre are moved in along the ray to
+#: it, and keep the seeds of their FAR_SEEDS nearest input faces: the distance to their foot is
+#: then the least to rounding (``docs/limit.md``), and squared distances stay finite.
+FAR, FAR_SEEDS = 1e9, 4
 
 
-def seed_setup(inp: RefineInput):
-    """(limit matrix of the seed level's vertices over the control vertices, their (face, bary))."""
-    levels = SEED_LEVELS
+@dataclasses.dataclass(frozen=True, eq=False)
+class SeedMesh:
+    """The certificate's refined level: its faces, the matrix of its vertices over the control
+    vertices, each face's input face and corners there (``corners`` (m, 3, 3), barycentric over
+    ``inface``'s corners, in its unfolded chart), the matrix of its vertices' limit points, the
+    vertices that reach the limit surface over each face (CSR: ``face_rings``), the input's
+    halfedge twins with creases and the boundary as walls (−1), the control vertices that
+    faces use, the level's twins with its creases as walls, and the
+    input's corner vertices (tagged, or on three walls or more)."""
+
+    faces: np.ndarray
+    matrix: sp.csr_matrix
+    inface: np.ndarray
+    corners: np.ndarray
+    limits: sp.csr_matrix
+    ring_start: np.ndarray
+    ring: np.ndarray
+    walls: np.ndarray
+    used: np.ndarray
+    level_walls: np.ndarray
+    cone: np.ndarray
+
+
+def seed_levels(n_faces: int, scheme: str) -> int:
+    """The certificate's number of levels for an input of ``n_faces`` faces."""
+    growth = 4 if scheme == "loop" else 3
+    k = 1
+    while n_faces * growth**k < SEED_FACES and k < MAX_LEVELS:
+        k += 1
+    return k
+
+
+def seed_setup(inp: RefineInput) -> SeedMesh:
+    """The :class:`SeedMesh` of ``inp`` (topology only: positions come with each call)."""
+    levels = seed_levels(inp.n_faces, inp.scheme)
     r = refinement_of(dataclasses.replace(inp, levels=levels))
-    faces = r.faces
-    n = r.n_vertices
+    F, n = inp.faces, inp.n_vertices
+    twin = inp.level.twin
+    shape = np.repeat(EQUILATERAL[None], len(F), axis=0)
+    B = np.repeat(np.eye(3)[None], len(F), axis=0)
+    inface = np.arange(len(F))
+    for st in r.steps:  # as ``vertex_origins``, per face
+        ids, w = matrix_supports(st.matrix, n)
+        parent = st.face_parent
+        shape1 = child_shapes(F, twin, shape, st.faces, parent, ids, w)
+        B = barycentric(shape[parent][:, None], shape1) @ B[parent]
+        inface = inface[parent]
+        shape, F, n = shape1, st.faces, st.n_vertices
+        twin = build_level(F, n).twin
+    faces = np.ascontiguousarray(F, dtype=np.int64)
+    order = np.argsort(faces.ravel(), kind="stable")
+    vf_start = np.zeros(n + 1, np.int64)
+    np.cumsum(np.bincount(faces.ravel(), minlength=n), out=vf_start[1:])
+    ring_start, ring = face_rings(faces, vf_start, order // 3, 1 if inp.scheme == "loop" else 2, n)
     level = build_level(faces, n)
     fsh = np.asarray(r.sharp_faces)
     face_sharp = np.zeros(len(faces), dtype=bool)
@@ -48,15 +120,25 @@ def seed_setup(inp: RefineInput):
                                     np.asarray(r.sharpness, np.float64), inp.scheme)
     s = LimitSetup(level, tagged, esharp, face_sharp, corner, r, n, True)
     L, _, _ = _evaluate(s, inp.scheme, inp.loop_weights, None, True, 1e-12, 60)
-    M = (L @ r.matrix).tocsr()
-    face, bary = r.vertex_origin
-    used = face >= 0
-    return M[used], face[used], bary[used]
+    walls = inp.level.twin.copy()
+    if inp.level.hsharp is not None:
+        walls[np.isinf(inp.level.hsharp)] = -1
+    h = np.flatnonzero((walls < 0) & ((inp.level.twin < 0) | (np.arange(len(walls)) < inp.level.twin)))
+    ends = np.stack([inp.faces.ravel()[h], inp.faces[h // 3, (h % 3 + 1) % 3]])
+    cone = inp.corner | (np.bincount(ends.ravel(), minlength=inp.n_vertices) >= 3)
+    level_walls = twin.copy()
+    creases = np.asarray(r.sharp_edges, np.int64).reshape(-1, 2)[np.isinf(np.asarray(r.sharpness, np.float64))]
+    if len(creases):
+        key = np.sort(creases, axis=1) @ np.array([n, 1])
+        ends = np.sort(np.stack([faces.ravel(), np.roll(faces, -1, axis=1).ravel()], axis=1), axis=1) @ np.array([n, 1])
+        level_walls[np.isin(ends, key)] = -1
+    return SeedMesh(faces, r.matrix.tocsr(), inface, B, sp.csr_matrix(L @ r.matrix), ring_start, ring, walls,
+                    np.unique(inp.faces), level_walls, cone)
 
 
-def _newton_step(r, Du, Dv, Duu, Duv, Dvv):
-    """Newton step in (u, v) on |x − P|²/2 (``r = x − P``); Gauss–Newton where the full
-    Hessian is not positive definite."""
+def _hessian(r, Du, Dv, Duu, Duv, Dvv):
+    """The Hessian (a, b, c) of |x − P|²/2 in (u, v) (``r = x − P``), Gauss–Newton's where the
+    full one is not positive definite, and the descent direction's right side (gu, gv)."""
     a0 = np.einsum("ij,ij->i", Du, Du)
     b0 = np.einsum("ij,ij->i", Du, Dv)
     c0 = np.einsum("ij,ij->i", Dv, Dv)
@@ -65,30 +147,56 @@ def _newton_step(r, Du, Dv, Duu, Duv, Dvv):
     c = c0 - np.einsum("ij,ij->i", r, Dvv)
     spd = (a > 0) & (a * c - b * b > 0)
     a, b, c = np.where(spd, a, a0), np.where(spd, b, b0), np.where(spd, c, c0)
-    gu = np.einsum("ij,ij->i", Du, r)
-    gv = np.einsum("ij,ij->i", Dv, r)
+    return a, b, c, np.einsum("ij,ij->i", Du, r), np.einsum("ij,ij->i", Dv, r)
+
+
+#: The direction (du, dv) along the edge opposite each corner (the corner's coordinate constant).
+_ALONG = np.array([[1.0, -1.0], [0.0, 1.0], [1.0, 0.0]])
+
+
+def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
+    """Newton step in (u, v) on |x − P|²/2; on a wall (a crease or boundary edge of the face, the
+    point on it) a step out of the face is replaced by Gauss–Newton's step along the wall, at a corner of
+    two walls by none, and at a corner vertex (``cone_at`` (k, 3): the face's corners that are
+    tagged corners or meet three walls or more) a step on past it by none."""
+    a, b, c, gu, gv = _hessian(r, Du, Dv, Duu, Duv, Dvv)
+    # Along a wall, Gauss–Newton's curvature: second derivatives mean little at creases.
+    a0, b0, c0 = (np.einsum("ij,ij->i", x, y) for x, y in ((Du, Du), (Du, Dv), (Dv, Dv)))
     det = a * c - b * b
     det = np.where(np.abs(det) > 0, det, 1.0)
-    return (c * gu - b * gv) / det, (a * gv - b * gu) / det
+    du, dv = (c * gu - b * gv) / det, (a * gv - b * gu) / det
+    on_wall = (bary <= 1e-10) & (walls[3 * face[:, None] + (np.arange(3) + 1) % 3] < 0)
+    for _ in range(2):
+        for j in range(3):
+            delta = (-du - dv, du, dv)[j]
+            out = on_wall[:, j] & (delta < 0)
+            if out.any():
+                eu, ev = _ALONG[j]
+                curv = a0 * eu * eu + 2 * b0 * eu * ev + c0 * ev * ev
+                t = (gu * eu + gv * ev) / np.where(curv > 0, curv, 1.0)
+                du, dv = np.where(out, t * eu, du), np.where(out, t * ev, dv)
+    delta = np.stack([-du - dv, du, dv], axis=1)
+    stuck = (on_wall & (delta < -1e-300)).any(axis=1)
+    stuck |= ((bary >= 1 - 1e-10) & (delta > 0) & cone_at).any(axis=1)
+    return np.where(stuck, 0.0, du), np.where(stuck, 0.0, dv)
 
 
-def _move(face, bary, du, dv, twin0, F0):
-    """(u, v) moved by (du, dv), across at most one edge into the face there; clamped at the boundary."""
-    nb = bary + np.stack([-du - dv, du, dv], axis=1)
-    face, nb = onto_input_faces(face, nb, twin0, F0)
-    return face, nb
-
-
-def _iterate(surface, X, pts, face, bary, depth, max_iter, stop):
-    """Damped Gauss–Newton at one descent depth: a step that does not bring a point closer is
-    taken back and tried again four times shorter; a point stops when its step is below ``stop``."""
-    inp = surface._inp
-    twin0, F0 = inp.level.twin, inp.faces
+def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=None, low=None, gap=0.0):
+    """Damped Newton at one descent depth: a step that does not bring a point closer is taken
+    back and tried again four times shorter; a point stops when its Newton step moves it less
+    than ``stop`` (in space, in units of the diagonal).
+    Returns the best (face, bary) of each point, its distance, the surface point there and the
+    derivatives (Du, Dv, Duu, Duv, Dvv) (k, 5, 3). With ``point`` (k,), the query each row
+    belongs to, and ``low`` (k,), a lower bound on the distance each row can reach, a row stops
+    (distance ∞) once another row of its query is nearer than ``low − gap``."""
+    F0 = surface._inp.faces
+    walls, cone = seeds.walls, seeds.cone
     k = len(pts)
     best_f, best_b = face.copy(), bary.copy()
     best_d = np.full(k, np.inf)
     G = np.zeros((k, 5, 3))  # (Du, Dv, Duu, Duv, Dvv) at the best point
     R = np.zeros((k, 3))  # pts − P at the best point
+    Pb = np.zeros((k, 3))
     trust = np.ones(k)
     active = np.ones(k, dtype=bool)
     for _ in range(max_iter):
@@ -97,43 +205,189 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop):
             break
         P, *D = surface._applied(face[idx], bary[idx], 6, depth, X)
         d = np.linalg.norm(pts[idx] - P, axis=1)
-        better = d <= best_d[idx] * (1 + 1e-14)
+        # At a vertex or on a wall, a step that changes the distance by rounding only ends the
+        # row: it circles the vertex through the faces round it, or the derivatives along a
+        # crease (which mean little there) move it along a crease that is level to rounding.
+        edge = best_b[idx].min(axis=1) <= 1e-10
+        level = (np.isfinite(best_d[idx]) & (np.abs(d - best_d[idx]) <= 1e-15 * best_d[idx])
+                 & ((best_b[idx].max(axis=1) >= 1 - 1e-10) | edge))
+        better = d <= best_d[idx] * (1 + 1e-14) + 1e-15  # (the data are in units of the diagonal)
         ib = idx[better]
         best_f[ib], best_b[ib], best_d[ib] = face[ib], bary[ib], d[better]
         for j, Dj in enumerate(D):
             G[ib, j] = Dj[better]
         R[ib] = (pts[idx] - P)[better]
-        trust[ib] = np.minimum(1.0, 2.0 * trust[ib])
+        Pb[ib] = P[better]
+        trust[ib] = 1.0
         trust[idx[~better]] *= 0.25
-        du, dv = _newton_step(R[idx], *(G[idx, j] for j in range(5)))
+        du, dv = _newton_step(best_f[idx], best_b[idx], walls, cone[F0[best_f[idx]]], R[idx],
+                              *(G[idx, j] for j in range(5)))
         size = np.hypot(du, dv)
         scale = trust[idx] * np.minimum(1.0, MAX_STEP / np.maximum(size, 1e-300))
-        face[idx], bary[idx] = _move(best_f[idx], best_b[idx], du * scale, dv * scale, twin0, F0)
-        active[idx[(size < stop) & better]] = False
+        reach = np.linalg.norm(du[:, None] * G[idx, 0] + dv[:, None] * G[idx, 1], axis=1)
+        delta = np.stack([-du - dv, du, dv], axis=1) * scale[:, None]
+        # A step out through a wall of the face stops on it (the next one goes along it).
+        wall = walls[3 * best_f[idx][:, None] + (np.arange(3) + 1) % 3] < 0
+        bb = best_b[idx]
+        cut = np.where(wall & (delta < 0), bb / np.where(delta < 0, -delta, 1.0), 1.0).min(axis=1)
+        nb = bb + delta * np.minimum(cut, 1.0)[:, None]
+        face[idx], bary[idx] = onto_input_faces(best_f[idx], nb, walls, F0)
+        active[idx[((reach < stop) & better) | level]] = False
         active[idx[trust[idx] < 1e-12]] = False
-    return best_f, best_b
+        if point is not None:
+            U = np.full(point.max() + 1, np.inf)
+            np.minimum.at(U, point, best_d)
+            out = active & (low - gap > U[point])
+            active[out] = False
+            best_d[out] = np.inf
+    return best_f, best_b, best_d, Pb, G
+
+
+def _frame(X: np.ndarray, seeds: SeedMesh):
+    """Centre and scale of the data: the certificate works in units of the diagonal of the box
+    of the used control vertices (no overflow or underflow at any scale)."""
+    used = X[seeds.used]
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    centre = 0.5 * lo + 0.5 * hi
+    half = np.maximum(np.abs(hi - centre), np.abs(lo - centre))
+    m = float(half.max())
+    diag = 2 * m * float(np.linalg.norm(half / m)) if m > 0 else 0.0
+    return centre, (diag if diag > 0 and np.isfinite(diag) else 1.0)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class LevelState:
+    """The certificate's level at one set of control positions: its vertices ``P``, their
+    limit points ``limits``, each face's ``eps`` (ε_T) and the grid of cells over the faces."""
+
+    key: bytes
+    P: np.ndarray
+    limits: np.ndarray
+    eps: np.ndarray
+    grid: tuple
+
+
+def level_state(seeds: SeedMesh, Xn: np.ndarray) -> LevelState:
+    """The :class:`LevelState` of the control positions ``Xn`` (in units of the diagonal)."""
+    P = np.ascontiguousarray(seeds.matrix @ Xn)
+    faces = seeds.faces
+    eps = np.empty(len(faces))
+    ring_deviation(P, faces, seeds.ring_start, seeds.ring, eps)
+    lo, h, dims = _grid(P, P[faces])  # (every vertex of a refined level is used)
+    start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
+    cell_faces = bin_faces(P, faces, lo, h, dims, start)
+    return LevelState(_key(Xn), P, np.ascontiguousarray(seeds.limits @ Xn), eps, (lo, h, dims, start, cell_faces))
+
+
+def _key(Xn: np.ndarray) -> bytes:
+    return hashlib.blake2b(np.ascontiguousarray(Xn).tobytes(), digest_size=16).digest()
+
+
+def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.ndarray | None = None):
+    """The certificate on the level at ``state``: for each point, the survivors' seeds.
+
+    Returns ``(point, inface, bary, low)``: one seed per point and connected component of
+    its surviving triangles (meeting across edges that are not creases; the survivor nearest
+    the point), its barycentric coordinates over that input face (in its unfolded chart) and
+    the component's lower bound on the distance to the limit surface over it.
+    """
+    faces, P, eps = seeds.faces, state.P, state.eps
+    lo, h, dims, start, cell_faces = state.grid
+    m = len(pts)
+    f0 = np.full(m, -1, np.int64)
+    b0 = np.zeros((m, 3))
+    d2 = np.full(m, np.inf)
+    closest_in_grid(pts, P, faces, lo, h, dims, start, cell_faces, f0, b0, d2)
+    # An upper bound on the distance to the surface: the limit points of the nearest face's corners.
+    bound = np.linalg.norm(pts[:, None, :] - state.limits[faces[f0]], axis=2).min(axis=1) * (1 + 1e-15) + 1e-12
+    point, tri, lam, dist, lb = _survivors(pts, P, faces, eps, seeds.ring_start, seeds.ring, lo, h, dims, start,
+                                       cell_faces, bound)
+    order = np.lexsort((dist, point))
+    point, tri, lam, dist, lb = point[order], tri[order], lam[order], dist[order], lb[order]
+    start = np.searchsorted(point, np.arange(m + 1))
+    label = np.empty(len(tri), np.int64)
+    survivor_components(start, tri, seeds.level_walls, np.full(len(faces), -1, np.int64), label)
+    low = lb.copy()
+    np.minimum.at(low, label, lb)  # each component's lower bound, at its first survivor
+    first = label == np.arange(len(tri))  # the nearest survivor of each component
+    point, tri, lam, low = point[first], tri[first], lam[first], low[first]
+    if limit is not None and len(point):  # the nearest ``limit[i]`` seeds of point i (still sorted)
+        rank = np.arange(len(point)) - np.searchsorted(point, point)
+        keep = rank < limit[point]
+        point, tri, lam, low = point[keep], tri[keep], lam[keep], low[keep]
+    # The seed: the closest point of the limit points' mesh (vertices at their limit points,
+    # nearer the surface than the level) on the survivor and its neighbours this side of walls.
+    near = np.c_[tri, seeds.level_walls[3 * tri[:, None] + np.arange(3)] // 3]
+    near = -np.sort(-np.where(near >= 0, near, -1), axis=1)  # (−1 ends a row)
+    tri2 = np.full(len(tri), -1, np.int64)
+    lam2 = np.zeros((len(tri), 3))
+    closest_among(np.ascontiguousarray(pts[point]), state.limits, faces, near, tri2, lam2,
+                  np.full(len(tri), np.inf))
+    g = seeds.inface[tri2]
+    bary = np.einsum("ki,kij->kj", lam2, seeds.corners[tri2])
+    return point, g, bary, low
+
+
+def _survivors(pts, P, faces, eps, ring_start, ring, lo, h, dims, start, cell_faces, bound):
+    """Every (point, triangle, bary there, distance, lower bound) with the lower bound below ``bound``: the nearest
+    ``KEEP`` of each point, then again with four times as many for the points that had more."""
+    out = []
+    rows = np.arange(len(pts))
+    keep = KEEP
+    while len(rows):
+        m = len(rows)
+        cf = np.full((m, keep), -1, np.int64)
+        cb = np.zeros((m, keep, 3))
+        cd = np.full((m, keep), np.inf)
+        cl = np.zeros((m, keep))
+        count = np.zeros(m, np.int64)
+        faces_within(np.ascontiguousarray(pts[rows]), P, faces, eps, float(eps.max()), ring_start, ring, lo, h, dims,
+                     start, cell_faces, np.ascontiguousarray(bound[rows]), cf, cb, cd, cl, count)
+        done = count <= keep
+        ok = (np.arange(keep)[None, :] < count[:, None]) & done[:, None]
+        out.append((np.repeat(rows, keep)[ok.ravel()], cf[ok], cb[ok], cd[ok], cl[ok]))
+        rows, keep = rows[~done], 4 * keep
+    return tuple(np.concatenate(a) for a in zip(*out))
 
 
 def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     """``(face, bary, Q, dist)`` of the points ``pts`` on the limit surface of ``surface`` with controls ``X``."""
-    M, sf, sb = surface._seed_setup()
-    S = M @ X
-    k = min(SEEDS, len(S))
-    from scipy.spatial import cKDTree  # (imported when used: it costs start-up time)
-
-    _, near = cKDTree(S).query(pts, k=k)
-    near = near.reshape(len(pts), k).ravel()
-    many = np.repeat(pts, k, axis=0)
-    face, bary = _iterate(surface, X, many, sf[near].copy(), sb[near].copy(), min(COARSE_DEPTH, surface.depth),
-                          max_iter, COARSE_STEP)
-    # The best of each point's seeds goes on at the full depth.
-    d = np.linalg.norm(many - surface._applied(face, bary, 1, min(COARSE_DEPTH, surface.depth), X)[0], axis=1)
-    pick = np.arange(len(pts)) * k + np.argmin(d.reshape(len(pts), k), axis=1)
-    face, bary = _iterate(surface, X, pts, face[pick], bary[pick], surface.depth, min(max_iter, FINE_ITER),
-                          FINE_STEP)
-    Q, Du, Dv = surface.evaluate(face, bary, derivatives=True, vertices=X)
-    N = np.cross(Du, Dv)
-    d = pts - Q
-    dist = np.linalg.norm(d, axis=1)
-    sign = np.where(np.einsum("ij,ij->i", d, N) < 0, -1.0, 1.0)
+    seeds = surface._seed_setup()
+    centre, scale = _frame(X, seeds)
+    Xn = (X - centre) / scale
+    diff = pts - centre
+    size = np.abs(diff).max(axis=1)
+    unit = diff / np.where(size > 0, size, 1.0)[:, None]
+    length = np.linalg.norm(unit, axis=1)
+    with np.errstate(over="ignore"):
+        far = size / scale * length > FAR
+        q = np.where(far[:, None], unit / np.where(length > 0, length, 1.0)[:, None] * FAR, diff / scale)
+    state = surface._level_state
+    if state is None or state.key != _key(Xn):
+        state = surface._level_state = level_state(seeds, Xn)
+    F0 = surface._inp.faces
+    point, sf, sb, low = candidates(seeds, state, np.ascontiguousarray(q), np.where(far, FAR_SEEDS, len(F0)))
+    sf, sb = onto_input_faces(sf, sb, seeds.walls, F0)
+    many = q[point]
+    coarse = min(COARSE_DEPTH, surface.depth)
+    face, bary, d, Pc, _ = _iterate(surface, Xn, many, sf, sb, coarse, max_iter, COARSE_STEP, seeds, point, low,
+                                    COARSE_GAP)
+    # Every seed whose coarse foot is near the best goes on at the full depth, once per place.
+    best = np.full(len(q), np.inf)
+    np.minimum.at(best, point, d)
+    go = np.flatnonzero(d <= best[point] + COARSE_GAP)
+    _, once = np.unique(np.c_[point[go], np.round(Pc[go] / COARSE_GAP)], axis=0, return_index=True)
+    go = go[once]
+    point, face, bary = point[go], face[go], bary[go]
+    face, bary, d, Qn, G = _iterate(surface, Xn, q[point], face, bary, surface.depth, min(max_iter, FINE_ITER),
+                                    FINE_STEP, seeds)
+    order = np.lexsort((d, point))
+    pick = order[np.r_[True, point[order][1:] != point[order][:-1]]]
+    face, bary, Qn, G = face[pick], bary[pick], Qn[pick], G[pick]
+    Q = centre + scale * Qn
+    N = np.cross(G[:, 0], G[:, 1])
+    e = pts - Q
+    size = np.abs(e).max(axis=1)
+    dist = size * np.linalg.norm(e / np.where(size > 0, size, 1.0)[:, None], axis=1)
+    sign = np.where(np.einsum("ij,ij->i", q - Qn, N) < 0, -1.0, 1.0)
     return face, bary, Q, sign * dist

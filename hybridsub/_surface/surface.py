@@ -40,6 +40,14 @@ def unit_normals(Du: np.ndarray, Dv: np.ndarray) -> np.ndarray:
     return np.divide(N, norm, out=np.zeros_like(N), where=norm > 0)
 
 
+def _numbers(a, name: str) -> np.ndarray:
+    """``a`` as a float64 array, or a TypeError naming the argument."""
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be an array of numbers ({e})") from None
+
+
 class LimitSurface:
     """The limit surface of a control mesh, evaluated at any point of its input faces.
 
@@ -101,6 +109,7 @@ class LimitSurface:
         self._V = X.copy()
         self._V.setflags(write=False)
         self._seeds = None
+        self._level_state = None  # the certificate's level at the last control positions projected on
         if depth is None:
             depth = _default_depth(scheme)
         if isinstance(depth, bool) or int(depth) != depth or depth < 0:
@@ -131,8 +140,12 @@ class LimitSurface:
         f = np.asarray(face)
         if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.all(f == np.round(f))):
             raise TypeError(f"face must be integers, got dtype {f.dtype}")
-        f = f.astype(np.int64).reshape(-1)
-        b = np.asarray(bary, dtype=np.float64)
+        f = f.reshape(-1)
+        big = np.flatnonzero(~(np.abs(f) < m)) if f.dtype.kind != "i" else np.zeros(0, np.int64)
+        if len(big):  # before the cast to int64, which would wrap
+            raise ValueError(f"face[{big[0]}] = {f[big[0]]} is not a face (the mesh has {m} faces)")
+        f = f.astype(np.int64)
+        b = _numbers(bary, "bary")
         if b.ndim == 1 and b.shape[0] == 3 and len(f) == 1:
             b = b[None]
         if b.ndim != 2 or b.shape != (len(f), 3):
@@ -279,11 +292,13 @@ class LimitSurface:
                 max_iter: int | None = None):
         """Closest points of the limit surface: ``(face, bary, Q, dist)``.
 
-        ``dist`` is signed: positive on the side the normals point to. Seeds come from a dense
-        sampling of the surface; Gauss–Newton on (face, u, v) then walks across face
-        boundaries to the foot point (``docs/limit.md``). ``max_iterations``: the most
-        Gauss–Newton steps per point (the name :func:`hybridsub.fit` uses; ``max_iter`` is its
-        deprecated alias).
+        ``dist`` is signed: positive on the side the normals point to. The foot is the
+        closest point: a refined level whose faces bound the limit surface over them (its
+        convex hull property) rules out every region that cannot hold a nearer point, and
+        Newton on (face, u, v) runs in every region that survives, along creases and the
+        boundary where the foot lies on them (``docs/limit.md``). ``max_iterations`` (an
+        integer, at least 1; the name :func:`hybridsub.fit` uses, ``max_iter`` its deprecated
+        alias) bounds the iterations of each run at the coarse descent depth.
 
         Examples
         --------
@@ -305,7 +320,11 @@ class LimitSurface:
         if len(X) != len(self._V):
             raise ValueError(f"vertices must have {len(self._V)} rows (the control mesh's), got {len(X)}")
         X = X if self._copy is None else X[self._copy]
-        pts = np.asarray(points, dtype=np.float64)
+        if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)):
+            raise TypeError(f"max_iterations must be an integer, got {max_iter!r}")
+        if max_iter < 1:
+            raise ValueError(f"max_iterations must be at least 1, got {max_iter}")
+        pts = _numbers(points, "points")
         if pts.ndim == 1 and pts.shape == (3,):
             pts = pts[None]
         if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():

@@ -76,30 +76,6 @@ def closest_among(points, P, faces, candidates, face_out, bary_out, d2_out):
 
 
 @kernel
-def face_systems(face, bary, metric, residual, H, g):
-    """Sum each point's data term into the blocks of its face: ``H[f, a, d, b, e] +=
-    bary_a bary_b metric_de`` and ``g[f, a, d] += bary_a (metric · residual)_d``.
-
-    ``face`` (m,), ``bary`` (m, 3), ``metric`` (m, 3, 3), ``residual`` (m, 3); ``H``
-    (nf, 3, 3, 3, 3) and ``g`` (nf, 3, 3) zeroed by the caller. Serial: one summation order.
-    """
-    for i in range(face.shape[0]):
-        f = face[i]
-        for d in range(3):
-            md = 0.0
-            for e in range(3):
-                md += metric[i, d, e] * residual[i, e]
-            for a in range(3):
-                g[f, a, d] += bary[i, a] * md
-        for a in range(3):
-            for b in range(3):
-                w = bary[i, a] * bary[i, b]
-                for d in range(3):
-                    for e in range(3):
-                        H[f, a, d, b, e] += w * metric[i, d, e]
-
-
-@kernel
 def bin_faces(P, faces, lo, h, dims, start):
     """Cell lists of a uniform grid: every face in each cell its bounding box touches.
 
@@ -221,3 +197,204 @@ def closest_in_grid(points, P, faces, lo, h, dims, start, cell_faces, face_out, 
                         dk += 2 * r if inner and r > 0 else 1
         face_out[i] = best
         d2_out[i] = bd
+
+
+@kernel(inline="always")
+def _face_d2(px, py, pz, P, faces, f):
+    """Squared distance from p to triangle ``f``, and its barycentric coordinates there."""
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    u, v, w = _closest_on_triangle(px, py, pz, P, a, b, c)
+    qx = u * P[a, 0] + v * P[b, 0] + w * P[c, 0]
+    qy = u * P[a, 1] + v * P[b, 1] + w * P[c, 1]
+    qz = u * P[a, 2] + v * P[b, 2] + w * P[c, 2]
+    return (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2, u, v, w
+
+
+@kernel
+def face_rings(faces, vf_start, vf_faces, rings, n_vertices):
+    """The vertices within ``rings`` rings of each face, as CSR ``(start, vertices)``.
+
+    Ring 1 holds the vertices of the faces that share a vertex with the face, ring 2 adds
+    those of the faces that share a vertex with ring 1. ``vf_start`` (n + 1,), ``vf_faces``:
+    the faces round each vertex (CSR).
+    """
+    nf = faces.shape[0]
+    stamp = np.full(n_vertices, -1, np.int64)
+    start = np.zeros(nf + 1, np.int64)
+    out = np.empty(0, np.int64)
+    for fill in range(2):
+        stamp[:] = -1
+        n = 0
+        for f in range(nf):
+            for a in range(3):
+                va = faces[f, a]
+                for s in range(vf_start[va], vf_start[va + 1]):
+                    g = vf_faces[s]
+                    for b in range(3):
+                        vb = faces[g, b]
+                        if stamp[vb] != f:
+                            stamp[vb] = f
+                            if fill:
+                                out[n] = vb
+                            n += 1
+                        if rings > 1:
+                            for t in range(vf_start[vb], vf_start[vb + 1]):
+                                h = vf_faces[t]
+                                for c in range(3):
+                                    vc = faces[h, c]
+                                    if stamp[vc] != f:
+                                        stamp[vc] = f
+                                        if fill:
+                                            out[n] = vc
+                                        n += 1
+            if not fill:
+                start[f + 1] = n
+        if not fill:
+            out = np.empty(n, np.int64)
+    return start, out
+
+
+@kernel(parallel=True)
+def ring_deviation(P, faces, ring_start, ring, out):
+    """For each face, the largest distance from it to a vertex of its ring (``face_rings``)."""
+    for f in prange(faces.shape[0]):
+        best = 0.0
+        for s in range(ring_start[f], ring_start[f + 1]):
+            v = ring[s]
+            d2, _, _, _ = _face_d2(P[v, 0], P[v, 1], P[v, 2], P, faces, f)
+            best = max(best, d2)
+        out[f] = np.sqrt(best)
+
+
+@kernel(parallel=True)
+def faces_within(points, P, faces, eps, eps_max, ring_start, ring, lo, h, dims, start, cell_faces, bound, out_face,
+                 out_bary, out_d, out_lb, count):
+    """For each point i, the faces f whose lower bound on the distance to the limit surface over
+    them is below ``bound[i]``.
+
+    The limit surface over f lies in the convex hull of its ring's vertices, so no nearer to
+    p than ``d − eps[f]`` (d = dist(p, f)) nor than ``d − max_v n·(v − c)`` (c the closest
+    point of f, n = (p − c) / d: the plane through c normal to n, pushed out to the ring, has
+    the hull on one side). The grid of :func:`bin_faces` is visited in shells as
+    :func:`closest_in_grid` does, until no face of the next shell can be nearer than
+    ``bound[i] + eps_max``. Keeps the ``out_face.shape[1]`` nearest such faces (by distance),
+    their closest points' barycentric coordinates ``out_bary`` (m, K, 3), distances
+    ``out_d`` (m, K) and lower bounds ``out_lb`` (m, K); ``count[i]`` counts the faces that
+    qualified (above K: some left out).
+    """
+    m = points.shape[0]
+    K = out_face.shape[1]
+    nmax = max(dims[0], max(dims[1], dims[2]))
+    for i in prange(m):
+        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+        reach = bound[i] + eps_max
+        n = 0
+        ci, wx = _home(px, lo[0], h, dims[0])
+        cj, wy = _home(py, lo[1], h, dims[1])
+        ck, wz = _home(pz, lo[2], h, dims[2])
+        delta = max(min(wx, min(wy, wz)), 0.0)
+        for r in range(nmax + 1):
+            if r > 0 and (r - 1) * h + delta >= reach:
+                break
+            for di in range(-r, r + 1):
+                ii = ci + di
+                if ii < 0 or ii >= dims[0]:
+                    continue
+                for dj in range(-r, r + 1):
+                    jj = cj + dj
+                    if jj < 0 or jj >= dims[1]:
+                        continue
+                    inner = abs(di) < r and abs(dj) < r
+                    dk = -r
+                    while dk <= r:
+                        kk = ck + dk
+                        if 0 <= kk < dims[2] and _cell_d2(px, py, pz, lo, h, ii, jj, kk) < reach * reach:
+                            cell = (ii * dims[1] + jj) * dims[2] + kk
+                            for t in range(start[cell], start[cell + 1]):
+                                n = _offer(px, py, pz, P, faces, eps, ring_start, ring, cell_faces[t], bound[i], n,
+                                           out_face[i], out_bary[i], out_d[i], out_lb[i])
+                        dk += 2 * r if inner and r > 0 else 1
+        count[i] = n
+
+
+@kernel(inline="always")
+def _offer(px, py, pz, P, faces, eps, ring_start, ring, f, bound, n, out_face, out_bary, out_d, out_lb):
+    """Face f offered to one point's survivors (``faces_within``); returns the new count."""
+    K = out_face.shape[0]
+    d2, u, v, w = _face_d2(px, py, pz, P, faces, f)
+    d = np.sqrt(d2)
+    lb = d - eps[f]
+    if lb >= bound:
+        return n
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    if d > 0.0:
+        cx = u * P[a, 0] + v * P[b, 0] + w * P[c, 0]
+        cy = u * P[a, 1] + v * P[b, 1] + w * P[c, 1]
+        cz = u * P[a, 2] + v * P[b, 2] + w * P[c, 2]
+        nx, ny, nz = (px - cx) / d, (py - cy) / d, (pz - cz) / d
+        reach = 0.0
+        for s in range(ring_start[f], ring_start[f + 1]):
+            x = ring[s]
+            reach = max(reach, nx * (P[x, 0] - cx) + ny * (P[x, 1] - cy) + nz * (P[x, 2] - cz))
+        lb = max(lb, d - reach)
+        if lb >= bound:
+            return n
+    for s in range(min(n, K)):
+        if out_face[s] == f:
+            return n
+    s = min(n, K)
+    if s == K:
+        if d >= out_d[K - 1]:
+            return n + 1
+        s = K - 1
+    while s > 0 and out_d[s - 1] > d:
+        out_face[s] = out_face[s - 1]
+        out_d[s] = out_d[s - 1]
+        out_lb[s] = out_lb[s - 1]
+        for e in range(3):
+            out_bary[s, e] = out_bary[s - 1, e]
+        s -= 1
+    out_face[s] = f
+    out_d[s] = d
+    out_lb[s] = lb
+    out_bary[s, 0], out_bary[s, 1], out_bary[s, 2] = u, v, w
+    return n + 1
+
+
+@kernel
+def survivor_components(start, tri, twin, slot, label):
+    """Connected components of each point's surviving triangles.
+
+    ``start`` (m + 1,) the CSR offsets of each point's survivors ``tri``; ``twin`` (3f,) the
+    level's halfedge twins, −1 across a wall (a crease or the boundary): survivors meet only
+    across other edges; ``slot`` (f,) all −1 (scratch, left so). ``label`` (len(tri),) is
+    filled with, for each survivor, the offset of the first survivor of its component.
+    """
+    for i in range(start.shape[0] - 1):
+        a, b = start[i], start[i + 1]
+        for s in range(a, b):
+            label[s] = s
+            slot[tri[s]] = s
+        for s in range(a, b):
+            t = tri[s]
+            for e in range(3):
+                h = twin[3 * t + e]
+                if h < 0:
+                    continue
+                r = slot[h // 3]
+                if r < 0:
+                    continue
+                x, y = _root(label, s), _root(label, r)
+                if x != y:
+                    label[max(x, y)] = min(x, y)
+        for s in range(a, b):
+            label[s] = _root(label, s)
+            slot[tri[s]] = -1
+
+
+@kernel(inline="always")
+def _root(label, s):
+    while label[s] != s:
+        label[s] = label[label[s]]
+        s = label[s]
+    return s

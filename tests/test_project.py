@@ -1,0 +1,171 @@
+"""LimitSurface.project: the foot is never farther than a known point of the surface.
+
+Oracles: points of the surface found by ``evaluate`` (a query pushed off a surface point y may
+land on another foot, never on one farther than y), the nearest of many surface samples for
+far points, and the convex-hull bound of the certificate checked at random surface points.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+import numpy as np
+import pytest
+
+import hybridsub
+from hybridsub._surface import project as P
+from hybridsub._surface._closest_kernels import bin_faces, faces_within
+from hybridsub._surface.mesh_closest import _grid
+
+DATA = pathlib.Path(__file__).parent / "data"
+MESHES = ["cube-meshed", "mesh_with_border"]  # 30° creases and corners; a boundary
+SCHEMES = ["loop", "sqrt3", "hybrid"]
+_SURFACES = {}
+
+
+def surface(name, scheme):
+    """The limit surface of a mesh of tests/data, creases and corners detected at 30° (none for √3)."""
+    key = (name, scheme)
+    if key not in _SURFACES:
+        m = hybridsub.read_mesh(DATA / f"{name}.off")
+        V, F = np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+        feat = hybridsub.detect_features(V, F, angle=30)
+        tags = {} if scheme == "sqrt3" else dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
+        _SURFACES[key] = hybridsub.LimitSurface(V, F, scheme=scheme, **tags)
+    return _SURFACES[key]
+
+
+def diagonal(s):
+    V = s.vertices
+    return float(np.linalg.norm(V.max(0) - V.min(0)))
+
+
+def pushed_off(s, n, seed):
+    """n surface points y and queries pushed off them along ± the normal by 1e-4 … 1e-1 diagonals."""
+    rng = np.random.default_rng(seed)
+    face = rng.integers(0, len(s.faces), n)
+    bary = rng.dirichlet([1, 1, 1], n)
+    Y = s.evaluate(face, bary)
+    N = s.normals(face, bary)
+    off = diagonal(s) * 10.0 ** rng.uniform(-4, -1, n) * rng.choice([-1.0, 1.0], n)
+    return Y, Y + off[:, None] * N
+
+
+def assert_no_farther(s, Q, Y):
+    _, _, foot, dist = s.project(Q)
+    got = np.linalg.norm(Q - foot, axis=1)
+    ref = np.linalg.norm(Q - Y, axis=1)
+    excess = (got - ref) / diagonal(s)
+    assert excess.max() <= 1e-12, (int(np.argmax(excess)), excess.max(), int((excess > 1e-12).sum()))
+    assert np.allclose(np.abs(dist), got, rtol=1e-12, atol=1e-15 * diagonal(s))
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("name", MESHES)
+def test_no_foot_is_farther_than_the_point_pushed_off(name, scheme):
+    s = surface(name, scheme)
+    Y, Q = pushed_off(s, 150, seed=1)
+    assert_no_farther(s, Q, Y)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("name", MESHES + ["fandisk", "octahedron", "tetrahedron"])
+def test_no_foot_is_farther_in_many_trials(name, scheme):
+    if name == "fandisk":
+        V, F = hybridsub.load_example()
+        feat = hybridsub.detect_features(V, F, angle=30)
+        tags = {} if scheme == "sqrt3" else dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
+        s = hybridsub.LimitSurface(V, F, scheme=scheme, **tags)
+    else:
+        s = surface(name, scheme)
+    for seed in range(2 if name == "fandisk" else 10):  # fandisk (12,946 faces): 2·10⁴ trials
+        Y, Q = pushed_off(s, 10000, seed=100 + seed)
+        assert_no_farther(s, Q, Y)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("name", MESHES)
+def test_far_points_are_no_farther_than_any_sample(name, scheme):
+    s = surface(name, scheme)
+    rng = np.random.default_rng(2)
+    face = rng.integers(0, len(s.faces), 4000)
+    Y = s.evaluate(face, rng.dirichlet([1, 1, 1], 4000))
+    d = rng.normal(size=(24, 3))
+    centre = 0.5 * (s.vertices.max(0) + s.vertices.min(0))
+    Q = centre + 10 * diagonal(s) * d / np.linalg.norm(d, axis=1, keepdims=True)
+    _, _, foot, _ = s.project(Q)
+    nearest = np.linalg.norm(Q[:, None] - Y[None], axis=2).min(axis=1)
+    assert (np.linalg.norm(Q - foot, axis=1) <= nearest + 1e-12 * diagonal(s)).all()
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("name", MESHES)
+def test_the_certificate_bound_holds_at_surface_points(name, scheme):
+    """Every surface point lies within the bound of some triangle of the certificate's level:
+    both ``dist(y, T) ≤ ε_T`` and the supporting-plane bound, the two the pruning relies on."""
+    s = surface(name, scheme)
+    seeds = s._seed_setup()
+    centre, scale = P._frame(s.vertices, seeds)
+    Xn = (s.vertices - centre) / scale
+    state = P.level_state(seeds, Xn)
+    X, eps = state.P, state.eps
+    rng = np.random.default_rng(3)
+    n = 3000
+    Y = np.ascontiguousarray(s.evaluate(rng.integers(0, len(s.faces), n), rng.dirichlet([1, 1, 1], n), vertices=Xn))
+    faces = seeds.faces
+    lo, h, dims = _grid(X, X[faces])
+    start = np.zeros(int(np.prod(dims)) + 1, np.int64)
+    cells = bin_faces(X, faces, lo, h, dims, start)
+    k = 4
+    count = np.zeros(n, np.int64)
+    faces_within(Y, X, faces, eps, float(eps.max()), seeds.ring_start, seeds.ring, lo, h, dims, start, cells,
+                 np.full(n, 1e-13), np.full((n, k), -1), np.zeros((n, k, 3)), np.full((n, k), np.inf),
+                 np.zeros((n, k)), count)
+    assert (count > 0).all(), int((count == 0).sum())
+    assert eps.max() < 0.05  # (a bound, not a vacuous one)
+
+
+def test_points_far_and_tiny_scales():
+    s = surface("cube-meshed", "loop")
+    face, bary, Q, dist = s.project([[1e160, 0, 0], [-1e300, 1e300, 0]])
+    assert np.isfinite(Q).all() and np.isfinite(dist).all()
+    assert np.allclose(np.abs(dist), [1e160, np.sqrt(2) * 1e300], rtol=1e-12)
+    assert np.allclose(s.evaluate(face, bary), Q)
+    Y, Qs = pushed_off(s, 40, seed=4)
+    base = s.project(Qs)
+    for k in (1e160, 1e-155):
+        t = hybridsub.LimitSurface(k * s.vertices, s.faces, s._inp.sharp_edges, scheme="loop",
+                                   corners=np.flatnonzero(s._inp.corner))
+        face, bary, Q, dist = t.project(k * Qs)
+        assert np.allclose(Q / k, base[2], rtol=0, atol=1e-12 * diagonal(s))
+        assert np.allclose(dist / k, base[3], rtol=1e-9)
+
+
+def test_bad_arguments_are_named():
+    s = surface("mesh_with_border", "loop")
+    for bad in (-5, 0):
+        with pytest.raises(ValueError, match="max_iter"):
+            s.project([[0.0, 0, 0]], max_iter=bad)
+    for bad in (2.5, True, "3", None):
+        with pytest.raises(TypeError, match="max_iter"):
+            s.project([[0.0, 0, 0]], max_iter=bad)
+    with pytest.raises(TypeError, match="points"):
+        s.project([["a", 0, 0]])
+    with pytest.raises(ValueError, match="points"):
+        s.project([[np.nan, 0, 0]])
+    with pytest.raises(ValueError, match=r"face\[0\] = 9223372036854775813 is not a face"):
+        s.evaluate(np.array([2**63 + 5], dtype=np.uint64), [[1, 0, 0]])
+    with pytest.raises(TypeError, match="bary"):
+        s.evaluate([0], [["x", 0, 0]])
+
+
+def test_far_points_that_the_nearest_vertex_seeds_missed():
+    """Far points over the boundary of mesh_with_border (√3), where seeds at the nearest limit
+    vertices led Newton to a foot 3e-5 diagonals farther than this surface point."""
+    s = surface("mesh_with_border", "sqrt3")
+    Q = np.array([[197.59550096, 393.3469516, 68.70678532], [132.68499864, 415.55984629, 8.36832889],
+                  [157.43110174, 410.49477949, 25.77949177], [19.17056492, 354.3507636, -179.23876057],
+                  [53.55921345, 398.13558584, -104.81957861], [14.97759516, 349.22268056, -184.97871889]])
+    Y = s.evaluate([955] * len(Q), [[1.51116200e-01, 8.48404413e-01, 4.79387163e-04]] * len(Q))
+    assert_no_farther(s, Q, Y)
