@@ -145,11 +145,13 @@ def test_points_far_and_tiny_scales():
 def test_bad_arguments_are_named():
     s = surface("mesh_with_border", "loop")
     for bad in (-5, 0):
-        with pytest.raises(ValueError, match="max_iter"):
-            s.project([[0.0, 0, 0]], max_iter=bad)
+        with pytest.raises(ValueError, match="max_iterations"):
+            s.project([[0.0, 0, 0]], max_iterations=bad)
     for bad in (2.5, True, "3", None):
-        with pytest.raises(TypeError, match="max_iter"):
-            s.project([[0.0, 0, 0]], max_iter=bad)
+        with pytest.raises(TypeError, match="max_iterations"):
+            s.project([[0.0, 0, 0]], max_iterations=bad)
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="max_iterations"):
+        s.project([[0.0, 0, 0]], max_iter=-5)  # the deprecated name, checked the same
     with pytest.raises(TypeError, match="points"):
         s.project([["a", 0, 0]])
     with pytest.raises(ValueError, match="points"):
