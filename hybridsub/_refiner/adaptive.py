@@ -23,9 +23,11 @@ touched, so the result has no T-vertex. Closure faces are never refined again.
 >>> from hybridsub._input import open_gate
 >>> inp = open_gate([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]], levels=1, scheme="loop")
 >>> mesh = start(inp)
->>> mesh, step = refine_region(mesh, np.array([True, False, False, False]), 0, "loop", "loop")
->>> len(mesh.faces), step.matrix.shape        # one face red, its three neighbours unchanged
-(6, (7, 4))
+>>> mesh, step = refine_region(mesh, np.array([True, True, False, False]), 0, "loop", "loop")
+>>> len(mesh.faces), step.matrix.shape    # one edge inside the region: split, its faces closed
+(6, (5, 4))
+>>> mesh.genuine.tolist()                 # the four closure faces, and the two faces not refined
+[False, False, False, False, True, True]
 """
 
 from __future__ import annotations

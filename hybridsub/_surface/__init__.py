@@ -7,10 +7,13 @@ of a level, on the sectors the topology layer cuts (``_topology.vertex_sectors``
 stars of the vertices without a stationary mask until their rows and normals settle; ``vertex_limit``
 holds the public functions. ``descent`` follows any point of the surface down the refinement
 (exact local refinement), ``surface`` is :class:`LimitSurface` on top of it, ``project`` its
-closest points. ``docs/limit.md`` explains every decision taken here.
+closest points. ``adaptive`` refines only where the output is not yet within a tolerance of
+the surface (the engine is the refiner's). ``docs/limit.md`` explains every decision taken here.
 """
 
 from .vertex_limit import limit_matrix, limit_normals, limit_positions
 from .surface import LimitSurface
+from .adaptive import AdaptiveWarning, refine_adaptive, subdivide_adaptive
 
-__all__ = ["LimitSurface", "limit_matrix", "limit_normals", "limit_positions"]
+__all__ = ["AdaptiveWarning", "LimitSurface", "limit_matrix", "limit_normals", "limit_positions", "refine_adaptive",
+           "subdivide_adaptive"]
