@@ -19,6 +19,7 @@ from .._refiner import FaceCharts, Refinement
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, LoopWeights, Scheme
+from .mask_plan import plan_level
 from .surface import LimitSurface
 
 #: How much one step divides a face's error by (its size squared): Loop halves edges, √3
@@ -130,6 +131,8 @@ class Criterion:
             self.error = self.error[step.face_parent]
             self.done = self.done[step.face_parent] & (mesh.face_level < k)
         fresh = np.flatnonzero(~self.done)
+        if self.limit or len(fresh):
+            self._masked_limits(mesh, active, k)
         self.error[fresh] = self._errors(mesh, fresh)
         self.done[fresh] = True
         want = np.zeros(len(mesh.faces), np.int64)
@@ -138,6 +141,44 @@ class Criterion:
         more = np.ceil(np.log(self.error[over] / self.tol) / np.log(rate[over])).astype(np.int64)
         want[over] = mesh.face_level[over] + np.maximum(more, 1)
         return want
+
+    def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, k: int) -> None:
+        """Limit positions by the stationary limit masks (those of ``limit_positions``), for the
+        vertices of level k without one yet whose faces are all active: their one-ring is the
+        uniform level's, at its positions. The rest are evaluated on the surface."""
+        F = mesh.faces
+        af = np.flatnonzero(active)
+        if not len(af):
+            return
+        n = mesh.n_vertices
+        all_count = np.bincount(F.ravel(), minlength=n)
+        act_count = np.bincount(F[af].ravel(), minlength=n)
+        todo = (act_count == all_count) & (act_count > 0) & ~self.known
+        if not todo.any():
+            return
+        ids = np.unique(F[af].ravel())
+        local = np.full(n, -1, np.int64)
+        local[ids] = np.arange(len(ids))
+        slot = np.full(len(F), -1, np.int64)
+        slot[af] = np.arange(len(af))
+        h = (3 * af[:, None] + np.arange(3)).ravel()
+        t = mesh.twin[h]
+        tf = np.where(t >= 0, slot[np.maximum(t, 0) // 3], -1)
+        level = build_level(local[F[af]], len(ids))
+        if not np.array_equal(level.twin, np.where(tf >= 0, 3 * tf + t % 3, -1)):  # pragma: no cover
+            raise AssertionError("the active faces' twins differ from the mesh's")
+        owner = level.edge_owner
+        hs = mesh.hsharp[h] if mesh.hsharp is not None and self.inp.scheme != "sqrt3" else np.zeros(len(h))
+        esharp = np.where(level.twin[owner] < 0, np.inf, hs[owner])
+        plan = plan_level(level, esharp, mesh.face_sharp[af], mesh.corner[ids], self.inp.scheme,
+                          self.inp.loop_weights)
+        v = np.flatnonzero(todo)
+        v = v[plan.pos_ok[local[v]]]
+        if not len(v):
+            return
+        L = plan.limit_csr(len(ids), only=local[v])
+        self.Q[v] = (L @ self.P[ids])[local[v]]
+        self.known[v] = True
 
     def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray) -> np.ndarray:
         """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
