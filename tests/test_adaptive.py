@@ -7,6 +7,7 @@ checks of ``tests/strategies.py`` (manifold, oriented, Euler characteristic, bou
 limit positions of ``hybridsub.limit_positions`` at the matched uniform vertices.
 """
 
+import json
 import os
 import warnings
 
@@ -271,3 +272,42 @@ def test_inputs_are_not_written_to():
     hybridsub.subdivide_adaptive(V, F, tolerance="2%", scheme="loop")
     hybridsub.refine_adaptive(F, where=np.zeros(len(F), bool), levels=1)
     assert np.array_equal(V, V0) and np.array_equal(F, F0)
+
+
+# ------------------------------------------------------------------------------------------
+# The command line
+# ------------------------------------------------------------------------------------------
+
+
+def test_cli_subdivide_to_a_tolerance(tmp_path, capsys):
+    from hybridsub._app.cli import main
+    src = os.path.join(DATA, "cube-meshed.off")
+    out = tmp_path / "a.obj"
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.5%", "--feature-angle", "30"]) == 0
+    err = capsys.readouterr().err
+    assert "adaptive to" in err and "error" in err
+    m = hybridsub.read_mesh(str(out))
+    given = hybridsub.read_mesh(src)
+    V, F = given.vertices, given.faces
+    feat = hybridsub.detect_features(V, F, 30)
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, feat.sharp_edges, tolerance="0.5%", corners=feat.corners)
+    assert np.array_equal(m.faces, F2) and np.allclose(m.vertices, V2, atol=1e-9)
+    assert len(m.sharp_edges) > 0  # the creases written back
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.5%", "--levels", "2"]) == 1
+    assert "exclude each other" in capsys.readouterr().err
+    for bad in ("0", "-1%", "abc", "inf"):
+        with pytest.raises(SystemExit) as e:
+            main(["subdivide", src, "-o", str(out), "--tolerance", bad])
+        assert e.value.code == 2
+
+
+def test_cli_info_reports_adaptive(capsys):
+    from hybridsub._app.cli import main
+    src = os.path.join(DATA, "icosahedron.off")
+    assert main(["info", src]) == 0
+    assert "add --tolerance" in capsys.readouterr().out
+    assert main(["info", src, "--tolerance", "1%", "--scheme", "loop", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)["adaptive"]
+    m = hybridsub.read_mesh(src)
+    V2, F2 = hybridsub.subdivide_adaptive(m.vertices, m.faces, tolerance="1%", scheme="loop")
+    assert rep["faces"] == len(F2) and rep["error"] <= rep["tolerance"]

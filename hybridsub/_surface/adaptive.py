@@ -259,8 +259,20 @@ def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, l
     if err > tol:
         warnings.warn(f"tolerance {tol:.6g} not reached in max_levels={max_levels} levels: the largest error is "
                       f"{err:.6g} ({err / tol:.3g}× the tolerance); raise max_levels to go further",
-                      AdaptiveWarning, stacklevel=3)
+                      AdaptiveWarning, stacklevel=4)
     return AdaptiveResult(run.refinement, P, err, tol)
+
+
+def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, tolerance,
+                    max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
+                    sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop") -> AdaptiveResult:
+    """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
+    command line)."""
+    X = as_vertices(V)
+    ml = _max_levels(max_levels)
+    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
+    return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights) -> RefineInput:
@@ -381,8 +393,6 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     >>> V2.shape[1], F2.shape[1]
     (3, 3)
     """
-    X = as_vertices(V)
-    ml = _max_levels(max_levels)
-    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
-    res = _by_tolerance(inp, X, tolerance, ml, bool(limit))
+    res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
+                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
     return res.positions.copy(), res.refinement.faces.copy()
