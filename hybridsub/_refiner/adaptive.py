@@ -185,12 +185,13 @@ def grow(mesh: AdaptiveMesh, mask: np.ndarray, rings: int) -> np.ndarray:
     return mask
 
 
-def graded(mesh: AdaptiveMesh, want: np.ndarray, rings: int) -> np.ndarray:
+def graded(mesh: AdaptiveMesh, want: np.ndarray, rings: int, k: int = 0) -> np.ndarray:
     """The wanted final level of each face (m,) raised so that levels fall by at most one
-    every ``rings`` vertex rings: the ring a face needs around it to be refined once more."""
+    every ``rings`` vertex rings: the ring a face needs around it to be refined once more.
+    Only wanted levels above ``k + 1`` are spread (what the steps from level k need)."""
     want = want.copy()
     top = int(want.max(initial=0))
-    for d in range(top, 1, -1):
+    for d in range(top, k + 1, -1):
         near = grow(mesh, want >= d, rings)
         want[near] = np.maximum(want[near], d - 1)
     return want
@@ -248,7 +249,8 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
         act = mesh.active(k)
         if on_level is not None:
             want = np.maximum(want, np.minimum(on_level(k, mesh, act, st), max_levels))
-        want = graded(mesh, want, rings)
+        if k == 0 or on_level is not None:  # else the children keep their parents' graded levels
+            want = graded(mesh, want, rings, k)
         need = want > k
         miss = need & ~act & (mesh.face_level <= k)
         if miss.any():
