@@ -23,8 +23,7 @@ import numpy as np
 from _bench import ROOT, cpu_name
 
 import hybridsub
-from hybridsub._refiner import FaceCharts
-from hybridsub._topology import build_level
+from hybridsub._surface.adaptive import adaptive_result, uniform_error
 
 MESHES = {"fandisk": os.path.join(ROOT, "hybridsub", "data", "fandisk.off"),
           "cube-meshed": os.path.join(ROOT, "tests", "data", "cube-meshed.off")}
@@ -42,29 +41,11 @@ def tags_of(feat, scheme):
     return {} if scheme == "sqrt3" else dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
 
 
-def uniform_error(V, F, tags, scheme, L, only=None):
-    """The largest face error of uniform level L (of the faces over input faces ``only``)."""
-    r = hybridsub.refine(F, levels=L, scheme=scheme, **tags)
-    P = hybridsub.limit_positions(V, F, levels=L, scheme=scheme, **tags)
-    G = r.faces
-    pick = np.arange(len(G)) if only is None else np.flatnonzero(np.isin(r.face_parent, only))
-    charts = FaceCharts(F, len(V), lambda A, n: build_level(A, n).twin)
-    for st in r.steps:
-        charts.step(st)
-    surf = hybridsub.LimitSurface(V, F, scheme=scheme, **tags)
-    Q = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3]])
-    f, b = charts.points(np.repeat(pick, len(Q)), np.tile(Q, (len(pick), 1)))
-    S = surf.evaluate(f, b).reshape(len(pick), len(Q), 3)
-    T = np.einsum("sj,fjc->fsc", Q, P[G[pick]])
-    return float(np.linalg.norm(S - T, axis=2).max())
-
-
 def tolerance_row(name, scheme, rel, quick):
     V, F, feat = load(name)
     tags = tags_of(feat, scheme)
     diag = float(np.linalg.norm(V.max(0) - V.min(0)))
     tol = rel * diag
-    from hybridsub._surface.adaptive import adaptive_result
     adaptive_result(V, F, tolerance=tol * 20, scheme=scheme, **tags)  # compile and warm up
     t = time.perf_counter()
     res = adaptive_result(V, F, tolerance=tol, scheme=scheme, **tags)
@@ -79,12 +60,12 @@ def tolerance_row(name, scheme, rel, quick):
             out["uniform"] = (f"> L{L - 1}", None, None, None)
             out["ratio"] = f"< {n_ad / n_u:.3f}"
             break
-        witness = uniform_error(V, F, tags, scheme, L, only=deep)
+        witness = uniform_error(V, F, L, only=deep, scheme=scheme, **tags)
         if witness > tol and n_u >= 2 * n_ad:
             out["uniform"] = (f"> L{L}", n_u, witness, None)
             out["ratio"] = f"< {n_ad / n_u:.3f}"
             break
-        err = witness if witness > tol else uniform_error(V, F, tags, scheme, L)
+        err = witness if witness > tol else uniform_error(V, F, L, scheme=scheme, **tags)
         if err <= tol:
             hybridsub.subdivide(V, F, levels=L, scheme=scheme, **tags)
             t = time.perf_counter()

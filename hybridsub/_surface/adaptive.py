@@ -15,12 +15,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
-from .._refiner import FaceCharts, Refinement
+from .._refiner import FaceCharts, Refinement, refine
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, LoopWeights, Scheme
 from .mask_plan import plan_level
 from .surface import LimitSurface
+from .vertex_limit import limit_positions
 
 #: How much one step divides a face's error by (its size squared): Loop halves edges, √3
 #: divides them by √3. Used to predict how many more levels a face needs.
@@ -273,6 +274,27 @@ def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     ml = _max_levels(max_levels)
     inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
+
+
+def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | None = None,
+                  scheme: Scheme = "hybrid", **tags) -> float:
+    """The error of the uniform level ``levels`` measured as adaptive refinement measures its
+    faces (corners at their limit positions, edge midpoints and centroids on the surface);
+    ``only``: just the faces over these input faces. For the benchmark and the figure."""
+    X = as_vertices(V)
+    r = refine(F, levels=levels, scheme=scheme, n_vertices=len(X), **tags)
+    P = limit_positions(X, F, levels=levels, scheme=scheme, **tags)
+    G = r.faces
+    pick = np.arange(len(G)) if only is None else np.flatnonzero(np.isin(r.face_parent, only))
+    charts = FaceCharts(r.coarse_faces, len(X), lambda A, n: build_level(A, n).twin)
+    for st in r.steps:
+        charts.step(st)
+    surface = LimitSurface(X, F, scheme=scheme, **tags)
+    Q = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3]])
+    f, b = charts.points(np.repeat(pick, len(Q)), np.tile(Q, (len(pick), 1)))
+    S = surface.evaluate(f, b).reshape(len(pick), len(Q), 3)
+    T = np.einsum("sj,fjc->fsc", Q, P[G[pick]])
+    return float(np.linalg.norm(S - T, axis=2).max(initial=0.0))
 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights) -> RefineInput:
