@@ -85,15 +85,13 @@ def start(inp: RefineInput) -> AdaptiveMesh:
                         np.ones(m, bool), np.arange(m, dtype=np.int64), np.zeros(n, np.int64), inp.corner.copy())
 
 
-def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
-                  loop_weights: str) -> tuple[AdaptiveMesh, RegionStep]:
-    """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module)."""
+def _region_level(mesh: AdaptiveMesh, region: np.ndarray):
+    """The faces ``region`` as a level of their own: (faces, vertices, the level, border halfedges)."""
     F, twin, n, m = mesh.faces, mesh.twin, mesh.n_vertices, len(mesh.faces)
     rf = np.flatnonzero(region)
     sub_ids = np.unique(F[rf].ravel())
     local = np.full(n, -1, np.int64)
     local[sub_ids] = np.arange(len(sub_ids))
-    ns = len(sub_ids)
     slot = np.full(m, -1, np.int64)
     slot[rf] = np.arange(len(rf))
     h = (3 * rf[:, None] + np.arange(3)).ravel()
@@ -102,8 +100,31 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     ts = np.where(tf >= 0, 3 * tf + t % 3, -1)
     border = (t >= 0) & (tf < 0)  # R on one side only: not split, not flipped
     hs = None if mesh.hsharp is None else mesh.hsharp[h]
-    Fs = local[F[rf]]
-    level = Level(Fs, ns, ts, hs, mesh.face_sharp[rf])
+    level = Level(local[F[rf]], len(sub_ids), ts, hs, mesh.face_sharp[rf])
+    return rf, sub_ids, local, level, border
+
+
+def _region_matrix(S: sp.csr_matrix, sub_ids, local, promoted, kept_new, n: int, n1: int) -> sp.csr_matrix:
+    """The step's (n1, n) matrix: the uniform rows of the promoted vertices and the kept new
+    points (``S``'s, over the region's vertices), identity rows for every other vertex."""
+    SA = sp.csr_matrix((S.data, sub_ids[S.indices], S.indptr), shape=(S.shape[0], n))
+    prom = np.flatnonzero(promoted)
+    src = np.concatenate([local[prom], kept_new])
+    dst = np.concatenate([prom, np.arange(n, n1)])
+    pick = sp.csr_matrix((np.ones(len(src)), (dst, src)), shape=(n1, S.shape[0]))
+    stay = np.flatnonzero(~promoted)
+    ident = sp.csr_matrix((np.ones(len(stay)), (stay, stay)), shape=(n1, n))
+    M = (pick @ SA + ident).tocsr()
+    M.sort_indices()
+    return M
+
+
+def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
+                  loop_weights: str) -> tuple[AdaptiveMesh, RegionStep]:
+    """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module)."""
+    F, n = mesh.faces, mesh.n_vertices
+    rf, sub_ids, local, level, border = _region_level(mesh, region)
+    ns, Fs = len(sub_ids), level.faces
     plan = plan_step(level, mesh.corner[sub_ids], scheme, k + 1, loop_weights)
     faces_c, child, offsets = child_level(level, plan)
     S = step_matrix(level, plan).tocsr()
@@ -130,17 +151,7 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     r_count = np.bincount(F[rf].ravel(), minlength=n)
     promoted = (r_count == all_count) & (r_count > 0)
     prom = np.flatnonzero(promoted)
-
-    # The step's matrix: identity rows, the uniform rows of promoted and kept new points.
-    cols = sub_ids[S.indices]
-    SA = sp.csr_matrix((S.data, cols, S.indptr), shape=(n_sub_new, n))
-    src = np.concatenate([local[prom], kept_new])
-    dst = np.concatenate([prom, np.arange(n, n1)])
-    pick = sp.csr_matrix((np.ones(len(src)), (dst, src)), shape=(n1, n_sub_new))
-    stay = np.flatnonzero(~promoted)
-    ident = sp.csr_matrix((np.ones(len(stay)), (stay, stay)), shape=(n1, n))
-    M = (pick @ SA + ident).tocsr()
-    M.sort_indices()
+    M = _region_matrix(S, sub_ids, local, promoted, kept_new, n, n1)
 
     # Faces: each face of R replaced by its children (degenerate closure ones left out), the
     # rest kept, in the order of the faces they come from.
