@@ -133,7 +133,7 @@ def test_tolerance_is_reached_and_limit_positions_are_exact(scheme):
     V, F = ms.torus(8, 6)
     feat_edges = np.array([[0, 1], [1, 2], [2, 3]])
     tags = dict(sharp_edges=feat_edges)
-    tol = 2e-3 * diagonal(V)
+    tol = (2e-3 if scheme == "loop" else 6e-3) * diagonal(V)  # the surface evaluator is slower on √3 faces
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         r = hybridsub.refine_adaptive(F, V=V, tolerance=tol, scheme=scheme, **tags)
@@ -149,11 +149,7 @@ def test_tolerance_is_reached_and_limit_positions_are_exact(scheme):
             continue
         L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
         d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
-        if scheme == "loop":
-            assert d.max() <= 1e-12, (j, d.max())
-        else:  # a vertex without a complete ring of its level is put on LimitSurface.evaluate,
-            # which at a few points near crease ends differs from the masks (docs/adaptive.md)
-            assert (d <= 1e-12).mean() >= 0.99 and d.max() <= 1e-4, (j, d.max())
+        assert d.max() <= 1e-12, (j, d.max())
     # The tolerance holds on a denser sample than the criterion's: 15 points per face.
     charts = hybridsub._refiner.FaceCharts(F, len(V), lambda G, n: hybridsub._topology.build_level(G, n).twin)
     for st_ in r.steps:
@@ -311,3 +307,24 @@ def test_cli_info_reports_adaptive(capsys):
     m = hybridsub.read_mesh(src)
     V2, F2 = hybridsub.subdivide_adaptive(m.vertices, m.faces, tolerance="1%", scheme="loop")
     assert rep["faces"] == len(F2) and rep["error"] <= rep["tolerance"]
+
+
+@cfg(10)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_tolerance_refinement_is_crack_free_and_exact(mesh, data):
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    tol = data.draw(st.sampled_from(["2%", "5%"]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance=tol, max_levels=2, scheme=scheme, **tags)
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance=tol, max_levels=2, scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces)
+    check_crack_free(V, F, r)
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    for j in range(int(r.vertex_level.max(initial=0)) + 1):
+        sel = np.flatnonzero((r.vertex_level == j) & np.isin(np.arange(r.n_vertices), F2))
+        if len(sel):
+            L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max() <= 1e-9, (j, float(d.max()), int((d > 1e-9).sum()), len(d))

@@ -423,7 +423,7 @@ def fig_adaptive(out, quick):
     handles = [plt.Line2D([], [], marker="s", ls="", color=shade(j), label=f"level {j}") for j in range(top + 1)]
     axs[0].legend(handles=handles, loc="lower left", fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.88, wspace=0.02)
-    _save(fig, os.path.join(out, "adaptive_fandisk.png"), 90 if quick else 150)
+    _save(fig, os.path.join(out, "adaptive_fandisk.png"), 90 if quick else 112)
 
 
 def main(argv=None):

@@ -71,6 +71,7 @@ class RegionStep:
     faces: np.ndarray
     matrix: sp.csr_matrix
     face_parent: np.ndarray  # (m',) the face of the previous adaptive mesh that emitted each face
+    source: np.ndarray  # (n' - n,) what made each new point: face f (f), or edge of halfedge h (m + h, h the lower)
 
     @property
     def n_vertices(self) -> int:
@@ -119,6 +120,21 @@ def _region_matrix(S: sp.csr_matrix, sub_ids, local, promoted, kept_new, n: int,
     return M
 
 
+def _sources(mesh: AdaptiveMesh, rf: np.ndarray, plan, n_new: int) -> np.ndarray:
+    """(n_new,) what made each point of a region's step (see ``RegionStep.source``; −1 for old vertices)."""
+    m = len(mesh.faces)
+    key = np.full(n_new, -1, np.int64)
+    fp = plan.face_point.astype(np.int64)
+    on = fp >= 0
+    key[fp[on]] = rf[on]
+    ep = plan.edge_point.astype(np.int64)
+    hh = np.flatnonzero(ep >= 0)
+    g = 3 * rf[hh // 3] + hh % 3
+    t = mesh.twin[g]
+    key[ep[hh]] = m + np.where(t >= 0, np.minimum(g, t), g)
+    return key
+
+
 def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
                   loop_weights: str) -> tuple[AdaptiveMesh, RegionStep]:
     """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module)."""
@@ -140,6 +156,7 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     dropped[ep[hb]] = True
     target[ep[hb]] = Fs.ravel()[hb]  # the halfedge's origin (sub numbering)
     kept_new = np.flatnonzero(~dropped[ns:]) + ns
+    source = _sources(mesh, rf, plan, n_sub_new)[kept_new]
     to_mesh = np.empty(n_sub_new, np.int64)
     to_mesh[:ns] = sub_ids
     to_mesh[kept_new] = n + np.arange(len(kept_new))
@@ -183,7 +200,7 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     faces1 = np.ascontiguousarray(faces1, dtype=np.int64)
     twin1 = build_level(faces1, n1).twin
     out = AdaptiveMesh(faces1, n1, twin1, hsharp, face_sharp, face_level, genuine, face_parent, vertex_level, corner)
-    return out, RegionStep(faces1, M, emitter)
+    return out, RegionStep(faces1, M, emitter, source)
 
 
 def grow(mesh: AdaptiveMesh, mask: np.ndarray, rings: int) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
 from .._refiner import FaceCharts, Refinement, refine
-from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
+from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement, refine_region
 from .._topology import build_level
 from .._typing import ArrayLike, LoopWeights, Scheme
 from .mask_plan import plan_level
@@ -105,6 +105,7 @@ class Criterion:
         self.P = X.copy()  # level positions
         self.Q = X.copy()  # output positions: limit positions where known
         self.known = np.zeros(len(X), bool)
+        self.prev = None  # the previous level: (mesh, active, k, positions)
         self.error = np.zeros(inp.n_faces)
         self.done = np.zeros(inp.n_faces, bool)
 
@@ -132,42 +133,37 @@ class Criterion:
             self.error = self.error[step.face_parent]
             self.done = self.done[step.face_parent] & (mesh.face_level < k)
         fresh = np.flatnonzero(~self.done)
-        if self.limit or len(fresh):
-            self._masked_limits(mesh, active, k)
-        self.error[fresh] = self._errors(mesh, fresh)
+        self._mask_pass(mesh, active)
+        self.error[fresh] = self._errors(mesh, fresh, step)
         self.done[fresh] = True
         want = np.zeros(len(mesh.faces), np.int64)
         over = self.error > self.tol
         rate = np.where(mesh.face_sharp, RATE[True], RATE[False])
         more = np.ceil(np.log(self.error[over] / self.tol) / np.log(rate[over])).astype(np.int64)
         want[over] = mesh.face_level[over] + np.maximum(more, 1)
+        self.prev = (mesh, active, k, self.P)
         return want
 
-    def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, k: int) -> None:
-        """Limit positions by the stationary limit masks (those of ``limit_positions``), for the
-        vertices of level k without one yet whose faces are all active: their one-ring is the
-        uniform level's, at its positions. The rest are evaluated on the surface."""
+    def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, P: np.ndarray, todo: np.ndarray):
+        """Limit positions by the stationary limit masks (those of ``limit_positions``) of the
+        vertices ``todo`` (n,) bool whose faces are all active: their one-ring is the uniform
+        level's, at its positions ``P``. Returns the vertices placed and their positions."""
         F = mesh.faces
         af = np.flatnonzero(active)
+        none = (np.empty(0, np.int64), np.empty((0, 3)))
         if not len(af):
-            return
+            return none
         n = mesh.n_vertices
         all_count = np.bincount(F.ravel(), minlength=n)
         act_count = np.bincount(F[af].ravel(), minlength=n)
-        todo = (act_count == all_count) & (act_count > 0) & ~self.known
+        todo = (act_count == all_count) & (act_count > 0) & todo
         if not todo.any():
-            return
+            return none
         ids = np.unique(F[af].ravel())
         local = np.full(n, -1, np.int64)
         local[ids] = np.arange(len(ids))
-        slot = np.full(len(F), -1, np.int64)
-        slot[af] = np.arange(len(af))
         h = (3 * af[:, None] + np.arange(3)).ravel()
-        t = mesh.twin[h]
-        tf = np.where(t >= 0, slot[np.maximum(t, 0) // 3], -1)
         level = build_level(local[F[af]], len(ids))
-        if not np.array_equal(level.twin, np.where(tf >= 0, 3 * tf + t % 3, -1)):  # pragma: no cover
-            raise AssertionError("the active faces' twins differ from the mesh's")
         owner = level.edge_owner
         hs = mesh.hsharp[h] if mesh.hsharp is not None and self.inp.scheme != "sqrt3" else np.zeros(len(h))
         esharp = np.where(level.twin[owner] < 0, np.inf, hs[owner])
@@ -176,17 +172,57 @@ class Criterion:
         v = np.flatnonzero(todo)
         v = v[plan.pos_ok[local[v]]]
         if not len(v):
-            return
+            return none
         L = plan.limit_csr(len(ids), only=local[v])
-        self.Q[v] = (L @ self.P[ids])[local[v]]
+        return v, (L @ P[ids])[local[v]]
+
+    def _mask_pass(self, mesh: AdaptiveMesh, active: np.ndarray) -> None:
+        v, q = self._masked_limits(mesh, active, self.P, ~self.known)
+        self.Q[v] = q
         self.known[v] = True
 
-    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray) -> np.ndarray:
+    def _virtual_pass(self, step: RegionStep, need: np.ndarray) -> np.ndarray:
+        """Limit positions of ``need`` (vertices of this level whose ring here is not complete)
+        from the uniform step of every active face of the previous level, made aside: there
+        their rings are complete more often. Returns the vertices still without one."""
+        if self.prev is None or not len(need):
+            return need
+        pm, pa, pk, PP = self.prev
+        if not pa.any():
+            return need
+        vm, vst = refine_region(pm, pa, pk, "hybrid" if self.inp.scheme == "sqrt3" else self.inp.scheme,
+                                self.inp.loop_weights)
+        n0 = pm.n_vertices
+        todo = np.zeros(vm.n_vertices, bool)
+        # Each vertex of this level in the aside step: old ones by index, new ones by what made them.
+        where = np.full(len(need), -1, np.int64)
+        old = need < n0
+        where[old] = need[old]
+        order = np.argsort(vst.source)
+        keys = vst.source[order]
+        k = step.source[need[~old] - n0]
+        at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+        hit = keys[at] == k
+        idx = np.flatnonzero(~old)
+        where[idx[hit]] = n0 + order[at[hit]]
+        found = where >= 0
+        todo[where[found]] = True
+        v, q = self._masked_limits(vm, vm.active(pk + 1), vst.matrix @ PP, todo)
+        got = np.full(vm.n_vertices, -1, np.int64)
+        got[v] = np.arange(len(v))
+        ok = found & (got[np.maximum(where, 0)] >= 0)
+        self.Q[need[ok]] = q[got[where[ok]]]
+        self.known[need[ok]] = True
+        return need[~ok]
+
+    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray, step: RegionStep | None) -> np.ndarray:
         """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
         once) and its centroid against the surface."""
         F = mesh.faces
         need = np.unique(F[fresh].ravel())
         need = need[~self.known[need]]
+        if step is not None:
+            need = self._virtual_pass(step, need)
         if len(need):
             self._limits(mesh, fresh, need)
         out = self.Q if self.limit else self.P
