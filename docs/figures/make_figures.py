@@ -1,5 +1,5 @@
-"""Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md, docs/semisharp.md
-and docs/face_varying.md.
+"""Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md, docs/semisharp.md,
+docs/face_varying.md and docs/adaptive.md.
 
 usage: python docs/figures/make_figures.py [--out DIR] [--quick]
 
@@ -392,13 +392,47 @@ def fig_textured(out, quick):
     _save(fig, os.path.join(out, "textured_bunny.png"), 100)
 
 
+def fig_adaptive(out, quick):
+    """Fandisk refined to a tolerance, faces coloured by level, beside the coarsest uniform
+    level that is as close (its error measured the same way)."""
+    from hybridsub._surface.adaptive import adaptive_result, uniform_error
+
+    V, F = hybridsub.load_example()
+    feat = hybridsub.detect_features(V, F, angle=30)
+    tags = dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    rel = 5e-3 if quick else 5e-4
+    res = adaptive_result(V, F, tolerance=rel * diag, **tags)
+    r = res.refinement
+    L = 1
+    while uniform_error(V, F, L, **tags) > res.tolerance and L < (1 if quick else 4):
+        L += 1
+    U = hybridsub.refine(F, levels=L, **tags)
+    PU = hybridsub.limit_positions(V, F, levels=L, **tags)
+    top = int(r.face_level.max())
+    cmap = plt.get_cmap("YlOrRd")
+    shade = (lambda j: cmap(0.12 + 0.78 * np.asarray(j) / max(top, 1)))
+    fig, axs = plt.subplots(1, 2, figsize=(12, 6.0))
+    az, el = 35, -60
+    render(axs[0], res.positions, r.faces, azim=az, elev=el, colors=shade(r.face_level)[:, :3], wire=0.3)
+    render(axs[1], PU, U.faces, azim=az, elev=el, wire=0.3)
+    counts = np.bincount(r.face_level, minlength=top + 1)
+    axs[0].set_title(f"adaptive, tolerance {rel:g} × diagonal: {len(r.faces):,} faces\n"
+                     + ", ".join(f"{c:,} at level {j}" for j, c in enumerate(counts)), fontsize=10)
+    axs[1].set_title(f"uniform level {L}: {len(U.faces):,} faces", fontsize=10)
+    handles = [plt.Line2D([], [], marker="s", ls="", color=shade(j), label=f"level {j}") for j in range(top + 1)]
+    axs[0].legend(handles=handles, loc="lower left", fontsize=8, frameon=False)
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.88, wspace=0.02)
+    _save(fig, os.path.join(out, "adaptive_fandisk.png"), 90 if quick else 112)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=HERE)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp, fig_textured):
+    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp, fig_textured, fig_adaptive):
         t = time.time()
         f(args.out, args.quick)
         print(f"{f.__name__}: {time.time() - t:.1f} s", file=sys.stderr)

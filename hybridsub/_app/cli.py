@@ -41,6 +41,8 @@ def _file_options(a: argparse.Namespace, **changes):
 def cmd_subdivide(a) -> int:
     from .pipeline import PipelineError, subdivide_file
 
+    if a.tolerance is not None and a.levels != 1:
+        raise PipelineError("--levels and --tolerance exclude each other: --tolerance chooses the levels")
     if not os.path.splitext(a.output)[1]:
         raise PipelineError(f"{a.output}: give the output file an extension (.obj, .ply, .off, .npz, .stl, .glb, …)")
     _writable(a.output, binary=not a.ascii)
@@ -225,6 +227,34 @@ def _info_subdivide(a, opts, mesh, lines: list[str], out: dict) -> None:
     lines.append("                counts are exact; memory is estimated from them (output: float64 positions and")
     lines.append("                int64 faces; peak: hybridsub subdivide making that level, holding it and the one "
                  "before" + (", and the UV index mesh's)" if keeps_uv(mesh, a.scheme) else ")"))
+    _info_adaptive(a, mesh, feat, lines, out)
+
+
+def _info_adaptive(a, mesh, feat, lines: list[str], out: dict) -> None:
+    """``info``'s adaptive lines: with ``--tolerance``, what adaptive refinement makes."""
+    import warnings
+
+    import numpy as np
+
+    from .._surface.adaptive import AdaptiveWarning, adaptive_result
+
+    if a.tolerance is None:
+        lines.append("  adaptive      add --tolerance TOL (e.g. 0.1%) to see what adaptive refinement would make")
+        return
+    t = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AdaptiveWarning)
+        res = adaptive_result(mesh.vertices, mesh.faces, tolerance=a.tolerance, max_levels=a.max_levels,
+                              scheme=a.scheme, loop_weights=a.loop_weights, **feat.tags())
+    seconds = time.perf_counter() - t
+    counts = np.bincount(res.refinement.face_level)
+    reached = "reached" if res.error <= res.tolerance else f"NOT reached in {a.max_levels} levels"
+    lines.append(f"  adaptive      --tolerance {a.tolerance} = {res.tolerance:.4g}: {len(res.refinement.faces):,} faces, "
+                 f"{len(res.positions):,} vertices, error {res.error:.4g} ({reached}), {seconds:.1f} s")
+    lines.append("                faces per level: " + "  ".join(f"{j}:{c:,}" for j, c in enumerate(counts) if c))
+    out["adaptive"] = {"tolerance": res.tolerance, "faces": len(res.refinement.faces),
+                       "vertices": len(res.positions), "error": res.error,
+                       "faces_per_level": counts.tolist(), "seconds": seconds}
 
 
 def _emit(a, lines, out, code) -> int:
@@ -317,6 +347,24 @@ def _positive(text: str) -> int:
     return k
 
 
+def _tolerance(text: str) -> str:
+    value = text.strip()
+    try:
+        x = float(value[:-1]) if value.endswith("%") else float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive number or a percentage such as 0.1%, got {text!r}") \
+            from None
+    if not (x > 0 and x != float("inf")):
+        raise argparse.ArgumentTypeError(f"must be positive and finite, got {text!r}")
+    return value
+
+
+def _tolerance_options(p, help_text: str) -> None:
+    p.add_argument("--tolerance", type=_tolerance, metavar="TOL", help=help_text)
+    p.add_argument("--max-levels", type=_levels, default=8, metavar="L",
+                   help="with --tolerance: the most levels any face gets (default: 8)")
+
+
 def _uv_option(p) -> None:
     p.add_argument("--uv-mode", choices=("linear", "smooth"),
                    help="texture coordinates (OBJ vt, PLY s t): linear (default) interpolates them, seams kept, "
@@ -380,6 +428,9 @@ def _add_subdivide(sub) -> None:
     s.add_argument("input", metavar="IN")
     s.add_argument("-o", "--output", metavar="OUT", required=True, help="output file; its extension picks the format")
     s.add_argument("--levels", type=_levels, default=1, help="subdivision steps (default: 1)")
+    _tolerance_options(s, "refine adaptively instead of --levels: only where the mesh is farther than TOL from "
+                          "the limit surface, until it is within TOL everywhere (mesh units, or '0.1%%' of the "
+                          "bounding-box diagonal); see docs/adaptive.md")
     _tag_options(s)
     _uv_option(s)
     s.add_argument("--non-manifold", choices=("raise", "cut"), default="raise", dest="non_manifold",
@@ -458,6 +509,8 @@ def _add_info(sub) -> None:
                                    "and memory of each level subdivide would produce with the same options.")
     i.add_argument("input", metavar="IN")
     i.add_argument("--levels", type=_levels, default=1, help="levels to predict (default: 1)")
+    _tolerance_options(i, "also run adaptive refinement to TOL (mesh units or '0.1%%' of the diagonal) and report "
+                          "the faces it makes per level beside the uniform levels")
     _tag_options(i)
     i.add_argument("--json", action="store_true", help="machine-readable output")
     i.set_defaults(func=cmd_info, quiet=False)

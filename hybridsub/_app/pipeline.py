@@ -60,6 +60,12 @@ class FileOptions:
         No messages and no progress bar.
     memory_limit : int, optional
         Bytes this run may use where less than the machine's RAM (a Dask worker's limit).
+    tolerance : str, optional
+        Adaptive refinement (``--tolerance``): refine until within this distance of the limit
+        surface, in mesh units or as ``"0.1%"`` of the bounding-box diagonal; ``levels`` is then
+        not used. See :func:`hybridsub.subdivide_adaptive`.
+    max_levels : int
+        With ``tolerance``: the most levels any face gets (``--max-levels``).
 
     Examples
     --------
@@ -86,6 +92,8 @@ class FileOptions:
     force: bool = False
     quiet: bool = False
     memory_limit: int | None = None
+    tolerance: str | None = None
+    max_levels: int = 8
 
 
 @dataclass
@@ -341,10 +349,14 @@ def subdivide_file(opts: FileOptions, src: str, dst: str, write_to: str | None =
     feat = gather_features(opts, mesh, src)
     t_read = time.perf_counter() - t0
     say(opts, feat.summary)
-    out, seconds = refine_mesh(opts, mesh, feat, src)
-    speed = f" ({rate(len(out.faces) / seconds)} faces/s)" if seconds > 0 and opts.levels else ""
-    say(opts, f"{SCHEME_NAMES[opts.scheme]}, {count_of(opts.levels, 'level')}: {len(mesh.faces):,} → "
-              f"{len(out.faces):,} faces, {len(out.vertices):,} vertices in {seconds:.2f} s{speed}")
+    if opts.tolerance is not None:
+        out, seconds, line = adaptive_mesh(opts, mesh, feat, src)
+        say(opts, line)
+    else:
+        out, seconds = refine_mesh(opts, mesh, feat, src)
+        speed = f" ({rate(len(out.faces) / seconds)} faces/s)" if seconds > 0 and opts.levels else ""
+        say(opts, f"{SCHEME_NAMES[opts.scheme]}, {count_of(opts.levels, 'level')}: {len(mesh.faces):,} → "
+                  f"{len(out.faces):,} faces, {len(out.vertices):,} vertices in {seconds:.2f} s{speed}")
     if opts.no_tags:
         out = replace(out, sharp_edges=np.empty((0, 2), np.int64), sharpness=np.empty(0),
                       corners=np.empty(0, np.int64), sharp_faces=np.empty(0, np.int64))
@@ -399,6 +411,46 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
     finally:
         bar.close()
     return _refined_mesh(mesh, res, vc, keep_uv, scheme), res.seconds
+
+
+def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
+                  path: str) -> tuple[TaggedMesh, float, str]:
+    """Adaptive refinement of ``mesh`` to ``opts.tolerance``: the refined mesh (positions at
+    the limit, colours by the refinement's matrix, tags), the seconds it took, and the line
+    that says what it made. Texture coordinates are dropped (with a note)."""
+    import warnings
+
+    from .._surface.adaptive import AdaptiveWarning, adaptive_result
+
+    if mesh.uv is not None:
+        say(opts, "note: texture coordinates dropped: adaptive refinement does not refine face-varying data yet")
+    t = time.perf_counter()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", AdaptiveWarning)
+            res = adaptive_result(mesh.vertices, mesh.faces, tolerance=opts.tolerance, max_levels=opts.max_levels,
+                                  scheme=opts.scheme, loop_weights=opts.loop_weights, **feat.tags())
+    except MeshError as e:
+        raise PipelineError(f"{path}: {e}") from None
+    except ValueError as e:
+        raise PipelineError(f"{path}: {e}") from None
+    seconds = time.perf_counter() - t
+    for w in caught:
+        say(opts, f"warning: {w.message}")
+    r = res.refinement
+    colors = None
+    if mesh.vertex_colors is not None:
+        colors = np.clip(r.apply(mesh.vertex_colors), 0, 1)
+    sf = np.asarray(r.sharp_faces)
+    sf = (np.flatnonzero(sf) if sf.dtype == bool else sf) if opts.scheme == "hybrid" else np.empty(0, np.int64)
+    fm = None if mesh.face_material is None else mesh.face_material[r.face_parent]
+    out = TaggedMesh(res.positions, r.faces, r.sharp_edges, r.sharpness, r.corners, sf, colors,
+                     material_libs=mesh.material_libs, materials=mesh.materials, face_material=fm)
+    counts = np.bincount(r.face_level)
+    per = ", ".join(f"{c:,} at {j}" for j, c in enumerate(counts) if c)
+    line = (f"{SCHEME_NAMES[opts.scheme]}, adaptive to {res.tolerance:.4g}: {len(mesh.faces):,} → {len(r.faces):,} "
+            f"faces ({per}), {len(res.positions):,} vertices, error {res.error:.4g}, in {seconds:.2f} s")
+    return out, seconds, line
 
 
 def _refined_mesh(mesh: TaggedMesh, res, vc, keep_uv: bool, scheme: str) -> TaggedMesh:

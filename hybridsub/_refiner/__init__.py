@@ -6,8 +6,8 @@ from here, never from the modules inside; the limit surface (``_surface``) and f
 
 from .budget import (cgroup_memory_limit, get_memory_limit, memory_source, physical_memory, predict_levels,
                      set_memory_limit)
-from .chart import (EQUILATERAL, barycentric, child_shapes, glue, glue_maps, matrix_supports, onto_input_faces,
-                    plan_supports, vertex_origins)
+from .chart import (EQUILATERAL, FaceCharts, barycentric, child_shapes, glue, glue_maps, matrix_supports,
+                    onto_input_faces, plan_supports, vertex_origins)
 from .facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
 from .fastpath import LevelOutput, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data
 from .refinement import Refinement, RefinementStep, refine, refinement_of
@@ -16,7 +16,7 @@ from .stencils import (CodedStencils, apply_coded, apply_matrix, coded_stencils,
                        step_matrix)
 
 __all__ = ["apply_coded", "apply_matrix", "barycentric", "cgroup_memory_limit", "child_shapes", "coded_stencils",
-           "CodedStencils", "EQUILATERAL", "FaceVaryingRefinement", "get_memory_limit", "glue", "glue_maps",
+           "CodedStencils", "EQUILATERAL", "FaceCharts", "FaceVaryingRefinement", "get_memory_limit", "glue", "glue_maps",
            "in_read_order", "LevelOutput", "matrix_supports", "memory_source", "onto_input_faces", "physical_memory",
            "plan_supports", "predict_levels", "refine", "refine_face_varying", "Refinement", "refinement_of",
            "RefinementStep", "seam_edges", "set_memory_limit", "sharpness_steps", "SharpnessSteps", "Slopes",

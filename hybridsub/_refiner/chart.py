@@ -186,6 +186,40 @@ def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: 
     return face, bary / bary.sum(axis=1, keepdims=True)
 
 
+class FaceCharts:
+    """Each face's corners over the input, followed step by step: ``inface`` (m,) the input
+    face whose unfolded chart holds the face, ``B`` (m, 3, 3) its corners' barycentric
+    coordinates there (negative across an edge of that face).
+
+    ``step(st)`` follows one :class:`RefinementStep` (faces, matrix, face_parent);
+    :meth:`points` puts points given over a face onto input faces.
+    """
+
+    def __init__(self, F0: np.ndarray, n0: int, twin_of):
+        self.F0, self.F, self.n = F0, F0, n0
+        self.twin_of = twin_of
+        self.shape = np.repeat(EQUILATERAL[None], len(F0), axis=0)
+        self.B = np.repeat(np.eye(3)[None], len(F0), axis=0)
+        self.inface = np.arange(len(F0))
+        self.twin0 = twin_of(F0, n0)
+        self.twin = self.twin0
+
+    def step(self, st) -> None:
+        ids, w = matrix_supports(st.matrix, self.n)
+        parent = st.face_parent
+        shape1 = child_shapes(self.F, self.twin, self.shape, st.faces, parent, ids, w)
+        lam = barycentric(self.shape[parent][:, None], shape1)
+        self.B = lam @ self.B[parent]
+        self.inface = self.inface[parent]
+        self.shape, self.F, self.n = shape1, st.faces, st.n_vertices
+        self.twin = self.twin_of(self.F, self.n)
+
+    def points(self, faces: np.ndarray, bary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points ``bary`` (k, 3) over the current faces ``faces`` (k,) as (input face, bary)."""
+        b = np.einsum("ki,kij->kj", bary, self.B[faces])
+        return onto_input_faces(self.inface[faces], b, self.twin0, self.F0)
+
+
 def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray, np.ndarray]:
     """(face, bary) of every vertex of the last of ``steps`` over the input faces ``F0``.
 
@@ -193,21 +227,10 @@ def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray,
     gives a level's halfedge twins. Each vertex is reported on the first face (in face order)
     of the finest level that uses it; a vertex no face uses gets face −1 and bary (1, 0, 0).
     """
-    F, n = F0, n0
-    shape = np.repeat(EQUILATERAL[None], len(F0), axis=0)
-    B = np.repeat(np.eye(3)[None], len(F0), axis=0)  # corners over the input face, its rhombus chart
-    inface = np.arange(len(F0))
-    twin0 = twin_of(F0, n0)
-    twin = twin0
+    charts = FaceCharts(F0, n0, twin_of)
     for st in steps:
-        ids, w = matrix_supports(st.matrix, n)
-        parent = st.face_parent
-        shape1 = child_shapes(F, twin, shape, st.faces, parent, ids, w)
-        lam = barycentric(shape[parent][:, None], shape1)
-        B = lam @ B[parent]
-        inface = inface[parent]
-        shape, F, n = shape1, st.faces, st.n_vertices
-        twin = twin_of(F, n)
+        charts.step(st)
+    F, n, B, inface, twin0 = charts.F, charts.n, charts.B, charts.inface, charts.twin0
     flat = F.ravel()
     first = np.full(n, -1, np.int64)
     order = np.arange(len(flat))[::-1]

@@ -107,6 +107,9 @@ class Refinement:
         :func:`hybridsub.refine_face_varying`); else None.
     max_memory : int, float, str or None
         The memory limit of the call, which forming ``matrix`` honours too.
+    face_level, vertex_level : (m_L,) and (n_L,) int64 or None
+        From :func:`hybridsub.refine_adaptive`: the level of each output face and vertex (each
+        vertex sits where the uniform refinement of its level puts it); None from ``refine``.
     """
 
     faces: np.ndarray
@@ -120,6 +123,8 @@ class Refinement:
     max_memory: MemoryLimit = field(default=None, repr=False)  # the limit forming ``matrix`` honours
     uv_refinement: Refinement | None = field(default=None, repr=False)  # the UV index mesh's, with uv_faces
     coarse_faces: np.ndarray | None = field(default=None, repr=False)  # the input's faces (for vertex_origin)
+    face_level: np.ndarray | None = field(default=None, repr=False)  # adaptive refinement: each face's level
+    vertex_level: np.ndarray | None = field(default=None, repr=False)  # and each vertex's
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property

@@ -8,12 +8,15 @@ stars of the vertices without a stationary mask until their rows and normals set
 holds the public functions. ``descent`` follows any point of the surface down the refinement
 (exact local refinement), ``surface`` is :class:`LimitSurface` on top of it, ``project`` its
 closest points, certified on the exact closest points of a refined level (``mesh_closest``,
-Numba kernels in ``_closest_kernels``; fitting uses them too). ``docs/limit.md`` explains every decision taken here.
+Numba kernels in ``_closest_kernels``; fitting uses them too). ``adaptive`` refines only where
+the output is not yet within a tolerance of the surface (the engine is the refiner's).
+``docs/limit.md`` explains every decision taken here.
 """
 
 from .vertex_limit import limit_matrix, limit_normals, limit_positions
 from .surface import LimitSurface
+from .adaptive import AdaptiveWarning, refine_adaptive, subdivide_adaptive
 from .mesh_closest import ClosestPoints, Footpoints, closest_points
 
-__all__ = ["ClosestPoints", "Footpoints", "LimitSurface", "closest_points", "limit_matrix", "limit_normals",
-           "limit_positions"]
+__all__ = ["AdaptiveWarning", "ClosestPoints", "Footpoints", "LimitSurface", "closest_points", "limit_matrix",
+           "limit_normals", "limit_positions", "refine_adaptive", "subdivide_adaptive"]

@@ -1,0 +1,456 @@
+"""Adaptive refinement, the public functions: :func:`refine_adaptive` (a region to a level,
+or a tolerance) and :func:`subdivide_adaptive` (positions within a tolerance of the limit).
+
+The engine is :mod:`hybridsub._refiner.adaptive`; this module adds the error criterion, which
+needs the limit surface: every output face is compared with the limit surface over it at the
+face's corners, edge midpoints and centroid, in the parameter chart (``docs/adaptive.md``).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._input import RefineInput, as_vertices, open_gate
+from .._refiner import FaceCharts, Refinement, refine
+from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement, refine_region
+from .._topology import build_level
+from .._typing import ArrayLike, LoopWeights, Scheme
+from .mask_plan import plan_level
+from .surface import LimitSurface
+from .vertex_limit import limit_positions
+
+#: How much one step divides a face's error by (its size squared): Loop halves edges, √3
+#: divides them by √3. Used to predict how many more levels a face needs.
+RATE = {True: 4.0, False: 3.0}
+
+
+class AdaptiveWarning(UserWarning):
+    """A tolerance that ``max_levels`` did not reach (the message gives the error reached)."""
+
+
+def _where_mask(where, m: int) -> np.ndarray:
+    """``where`` as an (m,) bool mask: a mask of the input faces or their indices."""
+    if where is None:
+        raise ValueError("refine_adaptive needs where= (faces to refine) with levels=, or V= with tolerance=")
+    A = np.asarray(where)
+    if A.dtype == bool:
+        if A.shape != (m,):
+            raise ValueError(f"where as a boolean mask must have one entry per face, shape ({m},), got {A.shape}")
+        return A.copy()
+    if A.ndim != 1 or (A.size and A.dtype.kind not in "iu"):
+        raise ValueError(f"where must be a boolean mask of the {m} faces or a 1-D array of face indices, "
+                         f"got an array of dtype {A.dtype} and shape {A.shape}")
+    A = A.astype(np.int64)
+    bad = np.flatnonzero((A < 0) | (A >= m))
+    if len(bad):
+        raise ValueError(f"where[{bad[0]}] = {A[bad[0]]} is not a face (the mesh has {m} faces)")
+    mask = np.zeros(m, bool)
+    mask[A] = True
+    return mask
+
+
+def tolerance_of(tolerance, V: np.ndarray) -> float:
+    """A tolerance in mesh units: a positive finite number, or ``"0.1%"`` of the bounding-box diagonal."""
+    if isinstance(tolerance, str):
+        text = tolerance.strip()
+        try:
+            value = float(text[:-1]) / 100.0 if text.endswith("%") else float(text)
+        except ValueError:
+            raise ValueError(f"tolerance must be a positive number or a percentage such as '0.1%', got "
+                             f"{tolerance!r}") from None
+        if text.endswith("%") and math.isfinite(value) and value > 0:
+            diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) if len(V) else 0.0
+            if not diag > 0:
+                raise ValueError(f"tolerance {tolerance!r} is relative to the bounding-box diagonal, which is 0")
+            value *= diag
+    elif isinstance(tolerance, (bool, np.bool_)) or not isinstance(tolerance, (int, float, np.integer, np.floating)):
+        raise ValueError(f"tolerance must be a positive number (mesh units) or a percentage string, got {tolerance!r}")
+    else:
+        value = float(tolerance)
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"tolerance must be positive and finite, got {tolerance!r}")
+    return value
+
+
+def _max_levels(max_levels) -> int:
+    if isinstance(max_levels, (bool, np.bool_)) or not isinstance(max_levels, (int, np.integer)) or max_levels < 0:
+        raise ValueError(f"max_levels must be a non-negative integer, got {max_levels!r}")
+    return int(max_levels)
+
+
+def _closed_for_sqrt3(inp: RefineInput) -> None:
+    if inp.scheme == "sqrt3" and inp.n_faces and (inp.level.twin < 0).any():
+        raise ValueError('adaptive refinement with scheme="sqrt3" needs a closed mesh (Kobbelt\'s boundary rule '
+                         'trisects boundary edges every other level, which a region cannot); use scheme="hybrid", '
+                         'whose boundary is a crease')
+
+
+class Criterion:
+    """The error criterion, called by the driver at every level (see ``OnLevel``).
+
+    Follows the refinement's positions (level positions, ``S @ V``) and every face's chart;
+    the error of a face is the largest distance between a point of the flat triangle (its
+    corners at the limit positions with ``limit``, else at their level positions) and the
+    limit surface at the same parameter, over its corners, edge midpoints and centroid. Errors are taken once, when a
+    face is made: a face's vertices never move afterwards.
+    """
+
+    def __init__(self, inp: RefineInput, X: np.ndarray, surface: LimitSurface, tolerance: float, limit: bool):
+        self.inp, self.surface, self.tol, self.limit = inp, surface, tolerance, limit
+        self.charts = FaceCharts(inp.faces, inp.n_vertices, lambda F, n: build_level(F, n).twin)
+        self.P = X.copy()  # level positions
+        self.Q = X.copy()  # output positions: limit positions where known
+        self.known = np.zeros(len(X), bool)
+        self.prev = None  # the previous level: (mesh, active, k, positions)
+        self.error = np.zeros(inp.n_faces)
+        self.done = np.zeros(inp.n_faces, bool)
+
+    def _limits(self, mesh: AdaptiveMesh, faces: np.ndarray, vertices: np.ndarray) -> None:
+        """Limit positions of ``vertices``, placed through the charts of ``faces`` (each vertex
+        through the first of them that uses it)."""
+        Fv = mesh.faces[faces]
+        first = np.full(mesh.n_vertices, -1, np.int64)
+        flat = Fv.ravel()
+        first[flat[::-1]] = np.arange(len(flat))[::-1]
+        at = first[vertices]
+        f, b = self.charts.points(faces[at // 3], np.eye(3)[at % 3])
+        self.Q[vertices] = self.surface.evaluate(f, b)
+        self.known[vertices] = True
+
+    def __call__(self, k: int, mesh: AdaptiveMesh, active: np.ndarray, step: RegionStep | None) -> np.ndarray:
+        if step is not None:
+            self.charts.step(step)
+            self.P = step.matrix @ self.P
+            # A vertex's limit position does not depend on its level: only new points need one.
+            Q = np.empty_like(self.P)
+            Q[:len(self.Q)] = self.Q
+            self.Q = Q
+            self.known = np.concatenate([self.known, np.zeros(len(self.P) - len(self.known), bool)])
+            self.error = self.error[step.face_parent]
+            self.done = self.done[step.face_parent] & (mesh.face_level < k)
+        fresh = np.flatnonzero(~self.done)
+        self._mask_pass(mesh, active)
+        self.error[fresh] = self._errors(mesh, fresh, step)
+        self.done[fresh] = True
+        want = np.zeros(len(mesh.faces), np.int64)
+        over = self.error > self.tol
+        rate = np.where(mesh.face_sharp, RATE[True], RATE[False])
+        more = np.ceil(np.log(self.error[over] / self.tol) / np.log(rate[over])).astype(np.int64)
+        want[over] = mesh.face_level[over] + np.maximum(more, 1)
+        self.prev = (mesh, active, k, self.P)
+        return want
+
+    def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, P: np.ndarray, todo: np.ndarray):
+        """Limit positions by the stationary limit masks (those of ``limit_positions``) of the
+        vertices ``todo`` (n,) bool whose faces are all active: their one-ring is the uniform
+        level's, at its positions ``P``. Returns the vertices placed and their positions."""
+        F = mesh.faces
+        af = np.flatnonzero(active)
+        none = (np.empty(0, np.int64), np.empty((0, 3)))
+        if not len(af):
+            return none
+        n = mesh.n_vertices
+        all_count = np.bincount(F.ravel(), minlength=n)
+        act_count = np.bincount(F[af].ravel(), minlength=n)
+        todo = (act_count == all_count) & (act_count > 0) & todo
+        if not todo.any():
+            return none
+        ids = np.unique(F[af].ravel())
+        local = np.full(n, -1, np.int64)
+        local[ids] = np.arange(len(ids))
+        h = (3 * af[:, None] + np.arange(3)).ravel()
+        level = build_level(local[F[af]], len(ids))
+        owner = level.edge_owner
+        hs = mesh.hsharp[h] if mesh.hsharp is not None and self.inp.scheme != "sqrt3" else np.zeros(len(h))
+        esharp = np.where(level.twin[owner] < 0, np.inf, hs[owner])
+        plan = plan_level(level, esharp, mesh.face_sharp[af], mesh.corner[ids], self.inp.scheme,
+                          self.inp.loop_weights)
+        v = np.flatnonzero(todo)
+        v = v[plan.pos_ok[local[v]]]
+        if not len(v):
+            return none
+        L = plan.limit_csr(len(ids), only=local[v])
+        return v, (L @ P[ids])[local[v]]
+
+    def _mask_pass(self, mesh: AdaptiveMesh, active: np.ndarray) -> None:
+        v, q = self._masked_limits(mesh, active, self.P, ~self.known)
+        self.Q[v] = q
+        self.known[v] = True
+
+    def _virtual_pass(self, step: RegionStep, need: np.ndarray) -> np.ndarray:
+        """Limit positions of ``need`` (vertices of this level whose ring here is not complete)
+        from the uniform step of every active face of the previous level, made aside: there
+        their rings are complete more often. Returns the vertices still without one."""
+        if self.prev is None or not len(need):
+            return need
+        pm, pa, pk, PP = self.prev
+        if not pa.any():
+            return need
+        vm, vst = refine_region(pm, pa, pk, "hybrid" if self.inp.scheme == "sqrt3" else self.inp.scheme,
+                                self.inp.loop_weights)
+        n0 = pm.n_vertices
+        todo = np.zeros(vm.n_vertices, bool)
+        # Each vertex of this level in the aside step: old ones by index, new ones by what made them.
+        where = np.full(len(need), -1, np.int64)
+        old = need < n0
+        where[old] = need[old]
+        order = np.argsort(vst.source)
+        keys = vst.source[order]
+        k = step.source[need[~old] - n0]
+        at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+        hit = keys[at] == k
+        idx = np.flatnonzero(~old)
+        where[idx[hit]] = n0 + order[at[hit]]
+        found = where >= 0
+        todo[where[found]] = True
+        v, q = self._masked_limits(vm, vm.active(pk + 1), vst.matrix @ PP, todo)
+        got = np.full(vm.n_vertices, -1, np.int64)
+        got[v] = np.arange(len(v))
+        ok = found & (got[np.maximum(where, 0)] >= 0)
+        self.Q[need[ok]] = q[got[where[ok]]]
+        self.known[need[ok]] = True
+        return need[~ok]
+
+    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray, step: RegionStep | None) -> np.ndarray:
+        """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
+        once) and its centroid against the surface."""
+        F = mesh.faces
+        need = np.unique(F[fresh].ravel())
+        need = need[~self.known[need]]
+        if step is not None:
+            need = self._virtual_pass(step, need)
+        if len(need):
+            self._limits(mesh, fresh, need)
+        out = self.Q if self.limit else self.P
+        corners = out[F[fresh]]  # (k, 3, 3)
+        err = np.linalg.norm(corners - self.Q[F[fresh]], axis=2).max(axis=1)
+        # Edge midpoints: each edge once, from the face of its higher halfedge when both are fresh.
+        h = (3 * fresh[:, None] + np.arange(3)).ravel()
+        t = mesh.twin[h]
+        is_fresh = np.zeros(len(F), bool)
+        is_fresh[fresh] = True
+        own = (t < 0) | (t < h) | ~is_fresh[np.maximum(t, 0) // 3]
+        ho = h[own]
+        mids = np.zeros((len(ho), 3))
+        i = ho % 3
+        mids[np.arange(len(ho)), i] = 0.5
+        mids[np.arange(len(ho)), (i + 1) % 3] = 0.5
+        f, b = self.charts.points(ho // 3, mids)
+        Fo = F[ho // 3]
+        flat = 0.5 * (out[Fo[np.arange(len(ho)), i]] + out[Fo[np.arange(len(ho)), (i + 1) % 3]])
+        e_own = np.linalg.norm(self.surface.evaluate(f, b) - flat, axis=1)
+        e_half = np.zeros(3 * len(F))
+        e_half[ho] = e_own
+        shared = ~own & (t >= 0)
+        e_half[h[shared]] = e_half[t[shared]]
+        err = np.maximum(err, e_half[h].reshape(-1, 3).max(axis=1))
+        f, b = self.charts.points(fresh, np.full((len(fresh), 3), 1.0 / 3.0))
+        e_c = np.linalg.norm(self.surface.evaluate(f, b) - corners.mean(axis=1), axis=1)
+        return np.maximum(err, e_c)
+
+    def positions(self, mesh: AdaptiveMesh) -> np.ndarray:
+        """The output positions: limit positions with ``limit``, else level positions."""
+        if not self.limit:
+            return self.P
+        missing = np.flatnonzero(~self.known)
+        used = np.zeros(mesh.n_vertices, bool)
+        used[mesh.faces.ravel()] = True
+        missing = missing[used[missing]]
+        if len(missing):
+            self._limits(mesh, np.arange(len(mesh.faces)), missing)
+        return self.Q
+
+
+@dataclass(frozen=True, eq=False)
+class AdaptiveResult:
+    """What a tolerance-driven refinement made: the refinement, the positions, the error."""
+
+    refinement: Refinement
+    positions: np.ndarray
+    error: float  # the largest face error, over the samples
+    tolerance: float
+
+
+def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, limit: bool) -> AdaptiveResult:
+    tol = tolerance_of(tolerance, X)
+    surface = LimitSurface(X, inp.faces, inp.sharp_edges, scheme=inp.scheme, sharpness=inp.sharpness,
+                           sharp_faces=inp.face_sharp if inp.scheme == "hybrid" else None,
+                           corners=np.flatnonzero(inp.corner), loop_weights=inp.loop_weights)
+    holder = {}
+
+    def on_level(k, mesh, active, step):
+        if k == 0:
+            holder["c"] = Criterion(inp, X, surface, tol, limit)
+        return holder["c"](k, mesh, active, step)
+
+    run = adaptive_refinement(inp, np.zeros(inp.n_faces, np.int64), max_levels, on_level)
+    c = holder.get("c")
+    if c is None:  # no faces
+        return AdaptiveResult(run.refinement, X.copy(), 0.0, tol)
+    P = c.positions(run.mesh)
+    err = float(c.error.max(initial=0.0))
+    if err > tol:
+        warnings.warn(f"tolerance {tol:.6g} not reached in max_levels={max_levels} levels: the largest error is "
+                      f"{err:.6g} ({err / tol:.3g}× the tolerance); raise max_levels to go further",
+                      AdaptiveWarning, stacklevel=4)
+    return AdaptiveResult(run.refinement, P, err, tol)
+
+
+def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, tolerance,
+                    max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
+                    sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop") -> AdaptiveResult:
+    """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
+    command line)."""
+    X = as_vertices(V)
+    ml = _max_levels(max_levels)
+    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
+    return _by_tolerance(inp, X, tolerance, ml, bool(limit))
+
+
+def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | None = None,
+                  scheme: Scheme = "hybrid", **tags) -> float:
+    """The error of the uniform level ``levels`` measured as adaptive refinement measures its
+    faces (corners at their limit positions, edge midpoints and centroids on the surface);
+    ``only``: just the faces over these input faces. For the benchmark and the figure."""
+    X = as_vertices(V)
+    r = refine(F, levels=levels, scheme=scheme, n_vertices=len(X), **tags)
+    P = limit_positions(X, F, levels=levels, scheme=scheme, **tags)
+    G = r.faces
+    pick = np.arange(len(G)) if only is None else np.flatnonzero(np.isin(r.face_parent, only))
+    charts = FaceCharts(r.coarse_faces, len(X), lambda A, n: build_level(A, n).twin)
+    for st in r.steps:
+        charts.step(st)
+    surface = LimitSurface(X, F, scheme=scheme, **tags)
+    Q = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3]])
+    f, b = charts.points(np.repeat(pick, len(Q)), np.tile(Q, (len(pick), 1)))
+    S = surface.evaluate(f, b).reshape(len(pick), len(Q), 3)
+    T = np.einsum("sj,fjc->fsc", Q, P[G[pick]])
+    return float(np.linalg.norm(S - T, axis=2).max(initial=0.0))
+
+
+def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights) -> RefineInput:
+    inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+    _closed_for_sqrt3(inp)
+    return inp
+
+
+def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where: ArrayLike | None = None,
+                    levels: int | None = None, V: ArrayLike | None = None, tolerance: float | str | None = None,
+                    max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
+                    sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                    n_vertices: int | None = None) -> Refinement:
+    """Refine only where it matters: a region to a level, or everywhere to a tolerance.
+
+    Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
+    times, the faces around them as much as the refinement needs (at most one level less
+    every one or two vertex rings). ``V=`` and ``tolerance=``: every face is refined until it
+    is within ``tolerance`` of the limit surface (see :func:`subdivide_adaptive`).
+
+    Every output vertex is a vertex of the uniform refinement of its level
+    (``vertex_level``), exactly where :func:`hybridsub.refine` puts it: ``apply`` gives those
+    positions. The output is crack-free: a closed, consistently oriented manifold input gives
+    one with the same Euler characteristic and no T-vertex. See ``docs/adaptive.md``.
+
+    Parameters
+    ----------
+    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, n_vertices
+        As for :func:`hybridsub.refine` (checked the same way). ``"sqrt3"`` needs a closed mesh.
+    where : (m,) bool mask or array_like of int
+        The input faces to refine ``levels`` times.
+    levels : int
+        How many times the faces in ``where`` are refined.
+    V : (n, 3) array_like of float
+        Control positions, for ``tolerance``.
+    tolerance : float or str
+        In mesh units, or a string such as ``"0.1%"`` of the bounding-box diagonal.
+    max_levels : int
+        With ``tolerance``: the most levels any face gets (default 8); a tolerance not reached
+        warns (``AdaptiveWarning``) with the error reached.
+    limit : bool
+        With ``tolerance``: measure the faces with their corners at their limit positions
+        (the output of :func:`subdivide_adaptive` with ``limit=True``); else at their level
+        positions (``apply(V)``).
+
+    Returns
+    -------
+    Refinement
+        As from ``refine``, plus ``face_level`` and ``vertex_level``; ``steps`` are the
+        adaptive steps (each step's ``face_parent`` is the face of the previous adaptive mesh
+        that made the face).
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V, F = hybridsub.load_example()
+    >>> r = hybridsub.refine_adaptive(F, where=[0, 1], levels=2, scheme="loop")
+    >>> int(r.face_level.max()), len(r.faces) < len(hybridsub.refine(F, levels=2, scheme="loop").faces)
+    (2, True)
+    """
+    if tolerance is not None or V is not None:
+        if where is not None or levels is not None:
+            raise ValueError("refine_adaptive takes where= with levels=, or V= with tolerance=, not both")
+        if V is None or tolerance is None:
+            raise ValueError("refine_adaptive with a tolerance needs both V= and tolerance=")
+        X = as_vertices(V)
+        ml = _max_levels(max_levels)
+        inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
+                    sharp_faces, corners, loop_weights)
+        return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
+    if levels is None:
+        raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
+    inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+    mask = _where_mask(where, inp.n_faces)
+    return adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels).refinement
+
+
+def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *,
+                       tolerance: float | str, max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
+                       sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+                       corners: ArrayLike | None = None,
+                       loop_weights: LoopWeights = "loop") -> tuple[np.ndarray, np.ndarray]:
+    """Subdivide until the mesh is within ``tolerance`` of the limit surface, only where needed.
+
+    Each face is refined until the largest distance between it and the limit surface over it,
+    measured at its corners, edge midpoints and centroid at the same surface parameter, is at
+    most ``tolerance`` (such a parametric distance bounds the distance both ways: from each
+    of those points of the output to the surface, and from the surface point to the output).
+    Faces are refined with the scheme's exact rules (``docs/adaptive.md``): every vertex is a
+    vertex of the uniform refinement of its level, and the output has no crack.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
+        As for :func:`hybridsub.subdivide`.
+    tolerance : float or str
+        In mesh units, or a string such as ``"0.1%"`` of the bounding-box diagonal.
+    max_levels : int
+        The most levels any face gets (default 8). A tolerance not reached: the result at
+        ``max_levels`` and an ``AdaptiveWarning`` giving the error reached.
+    limit : bool
+        True (default): the output vertices at their limit positions; False: at the positions
+        of their levels.
+
+    Returns
+    -------
+    V2 : (n', 3) float64
+    F2 : (m', 3) int64
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V, F = hybridsub.load_example()
+    >>> V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="1%", scheme="loop")
+    >>> V2.shape[1], F2.shape[1]
+    (3, 3)
+    """
+    res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
+                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+    return res.positions.copy(), res.refinement.faces.copy()

@@ -1,0 +1,330 @@
+"""Adaptive refinement (docs/adaptive.md): crack-free and exact, on random tagged meshes and the
+shipped ones.
+
+The oracles: the uniform refinement (``hybridsub.refine(...).apply(V)`` at every level, each
+adaptive vertex matched by position to a vertex of the uniform level it claims), the mesh
+checks of ``tests/strategies.py`` (manifold, oriented, Euler characteristic, boundary) and the
+limit positions of ``hybridsub.limit_positions`` at the matched uniform vertices.
+"""
+
+import json
+import os
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.spatial import cKDTree
+
+import strategies as ms
+
+hybridsub = pytest.importorskip("hybridsub")
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+SCALE = int(os.environ.get("HYBRIDSUB_PROPERTY_SCALE", "1"))
+
+
+def cfg(n):
+    return settings(max_examples=n * SCALE, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                           HealthCheck.filter_too_much])
+
+
+def diagonal(V):
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+
+
+def uniform_match(V, F, tags, scheme, r, X):
+    """For each level j, the uniform level-j index of every adaptive vertex of level j (by
+    position); asserts each lies on one, to 1e-12 × the diagonal."""
+    tol = 1e-12 * diagonal(V)
+    top = int(r.vertex_level.max(initial=0))
+    index = np.full(len(X), -1, np.int64)
+    for j in range(top + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        if not len(sel):
+            continue
+        U = hybridsub.refine(F, levels=j, scheme=scheme, n_vertices=len(V), **tags).apply(V) if j else V
+        d, idx = cKDTree(U).query(X[sel])
+        assert d.max() <= tol, (j, float(d.max()))
+        index[sel] = idx
+    return index
+
+
+def check_crack_free(V, F, r):
+    """Manifold, consistently oriented, no degenerate or duplicate face, every vertex used,
+    same Euler characteristic and as many boundary loops as the input (no T-vertex: one would
+    open a hole)."""
+    G = r.faces
+    ms.check_mesh(None, G, nV=r.n_vertices)
+    used = np.unique(F)
+    assert len(np.unique(G)) == r.n_vertices - (len(V) - len(used))
+    assert ms.euler(r.n_vertices, G) == ms.euler(len(V), F)
+    assert _loops(ms.boundary_edges(G)) == _loops(ms.boundary_edges(F))
+    assert len(r.face_level) == len(G) and len(r.vertex_level) == r.n_vertices
+    assert len(r.face_parent) == len(G)
+
+
+def _loops(E):
+    """Number of boundary loops (connected components of the boundary edges)."""
+    if not len(E):
+        return 0
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    verts, inv = np.unique(E, return_inverse=True)
+    inv = inv.reshape(-1, 2)
+    A = sp.coo_matrix((np.ones(len(E)), (inv[:, 0], inv[:, 1])), shape=(len(verts), len(verts)))
+    return connected_components(A, directed=False)[0]
+
+
+@cfg(30)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_region_refinement_is_crack_free_and_exact(mesh, data):
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
+    closed = not len(ms.boundary_edges(F))
+    if scheme == "sqrt3":
+        if not closed:
+            scheme = "hybrid"
+        else:
+            tags = {}
+    levels = data.draw(st.integers(0, 3 if len(F) <= 40 else 2))
+    rng = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1)))
+    form = data.draw(st.sampled_from(["mask", "indices"]))
+    where = rng.random(len(F)) < data.draw(st.sampled_from([0.05, 0.2, 0.5]))
+    arg = where if form == "mask" else np.flatnonzero(where)
+    r = hybridsub.refine_adaptive(F, where=arg, levels=levels, scheme=scheme, n_vertices=len(V), **tags)
+    check_crack_free(V, F, r)
+    X = r.apply(V)
+    uniform_match(V, F, tags, scheme, r, X)
+    # The faces asked for are refined `levels` times.
+    assert (r.face_level[where[r.face_parent]] == levels).all()
+    assert r.face_level.max(initial=0) <= levels
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
+def test_fandisk_region_exact_and_fewer_faces(scheme):
+    V, F = hybridsub.load_example()
+    feat = hybridsub.detect_features(V, F, 30)
+    tags = {} if scheme == "sqrt3" else dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
+    c = V[F].mean(axis=1)
+    where = np.argsort(np.linalg.norm(c - c[0], axis=1))[:len(F) // 7]  # a patch of 15 % of the faces
+    r = hybridsub.refine_adaptive(F, where=where, levels=2, scheme=scheme, **tags)
+    check_crack_free(V, F, r)
+    uniform_match(V, F, tags, scheme, r, r.apply(V))
+    uniform = hybridsub.refine(F, levels=2, scheme=scheme, **tags)
+    assert len(r.faces) < 0.5 * len(uniform.faces)
+    assert r.face_level.max() == 2 and r.face_level.min() == 0
+
+
+def test_everything_at_the_level_is_the_uniform_refinement():
+    V, F = ms.icosahedron()
+    for scheme in ("hybrid", "loop", "sqrt3"):
+        r = hybridsub.refine_adaptive(F, where=np.ones(len(F), bool), levels=2, scheme=scheme)
+        u = hybridsub.refine(F, levels=2, scheme=scheme)
+        assert np.array_equal(r.faces, u.faces) or len(r.faces) == len(u.faces)
+        assert np.allclose(r.apply(V)[:u.n_vertices].sum(0), u.apply(V).sum(0))
+        assert (r.face_level == 2).all() and (r.vertex_level == 2).all()
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid"])
+def test_tolerance_is_reached_and_limit_positions_are_exact(scheme):
+    V, F = ms.torus(8, 6)
+    feat_edges = np.array([[0, 1], [1, 2], [2, 3]])
+    tags = dict(sharp_edges=feat_edges)
+    tol = (2e-3 if scheme == "loop" else 6e-3) * diagonal(V)  # the surface evaluator is slower on √3 faces
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = hybridsub.refine_adaptive(F, V=V, tolerance=tol, scheme=scheme, **tags)
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance=tol, scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces)
+    check_crack_free(V, F, r)
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    # Output vertices at the limit positions of the uniform vertices they are.
+    surf = hybridsub.LimitSurface(V, F, scheme=scheme, **tags)
+    for j in range(int(r.vertex_level.max()) + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        if not len(sel):
+            continue
+        L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+        d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+        assert d.max() <= 1e-12, (j, d.max())
+    # The tolerance holds on a denser sample than the criterion's: 15 points per face.
+    charts = hybridsub._refiner.FaceCharts(F, len(V), lambda G, n: hybridsub._topology.build_level(G, n).twin)
+    for st_ in r.steps:
+        charts.step(st_)
+    g = np.linspace(0, 1, 5)
+    B = np.array([(a, b, 1 - a - b) for a in g for b in g if a + b <= 1 + 1e-12])
+    f, b = charts.points(np.repeat(np.arange(len(F2)), len(B)), np.tile(B, (len(F2), 1)))
+    S = surf.evaluate(f, b).reshape(len(F2), len(B), 3)
+    T = np.einsum("sj,fjc->fsc", B, V2[F2])
+    err = np.linalg.norm(S - T, axis=2).max()
+    assert err <= 1.5 * tol, err / tol
+    # Fewer faces than the uniform level that is as fine as the finest adaptive face.
+    top = int(r.face_level.max())
+    assert len(F2) < len(hybridsub.refine(F, levels=top, scheme=scheme, **tags).faces)
+
+
+def test_unreachable_tolerance_warns_with_the_error_reached():
+    V, F = ms.icosahedron()
+    with pytest.warns(hybridsub.AdaptiveWarning, match="not reached in max_levels=1"):
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance=1e-9, max_levels=1, scheme="loop")
+    assert len(F2) == 4 * len(F)
+
+
+def test_percent_tolerance_is_of_the_diagonal():
+    V, F = ms.icosahedron()
+    d = diagonal(V)
+    a = hybridsub.subdivide_adaptive(V, F, tolerance="0.5%", scheme="loop")
+    b = hybridsub.subdivide_adaptive(V, F, tolerance=0.005 * d, scheme="loop")
+    assert np.array_equal(a[1], b[1]) and np.allclose(a[0], b[0])
+
+
+def test_limit_false_gives_level_positions():
+    V, F = ms.icosahedron()
+    r = hybridsub.refine_adaptive(F, V=V, tolerance="1%", limit=False, scheme="loop")
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="1%", limit=False, scheme="loop")
+    assert np.array_equal(F2, r.faces)
+    assert np.allclose(V2, r.apply(V), atol=1e-14)
+
+
+def test_vertex_origin_of_an_adaptive_refinement():
+    V, F = ms.icosahedron()
+    r = hybridsub.refine_adaptive(F, where=[0, 1, 2], levels=2, scheme="loop")
+    face, bary = r.vertex_origin
+    surf = hybridsub.LimitSurface(V, F, scheme="loop")
+    P = surf.evaluate(face, bary)
+    index = uniform_match(V, F, {}, "loop", r, r.apply(V))
+    for j in range(3):
+        sel = r.vertex_level == j
+        L = hybridsub.limit_positions(V, F, levels=j, scheme="loop")
+        assert np.allclose(P[sel], L[index[sel]], atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------
+# Bad input: refused like refine refuses it, and the adaptive arguments by name
+# ------------------------------------------------------------------------------------------
+
+TET = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+TETV = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(F=[[0, 1, 2], [0, 1, 2]]),                      # duplicate faces
+    dict(F=[[0, 1, 2], [0, 1, 3], [0, 1, 4]]),            # non-manifold edge
+    dict(F=[[0, 1, 2], [1, 0, 3], [0, 1, 4]]),
+    dict(F=[[0, 1, 1]]),                                  # repeated vertex
+    dict(F=[[0, 1, 2.5]]),
+    dict(F=TET, sharp_edges=[[0, 5]]),                    # not an edge
+    dict(F=TET, sharpness=[1.0]),
+    dict(F=TET, scheme="catmull"),
+    dict(F=TET, sharp_faces=[7]),
+    dict(F=TET, corners=[9]),
+])
+def test_refused_like_refine(kwargs):
+    kwargs = dict(kwargs)
+    F = kwargs.pop("F")
+    with pytest.raises((ValueError, TypeError)) as uniform:
+        hybridsub.refine(F, levels=1, **kwargs)
+    with pytest.raises(type(uniform.value)) as adaptive:
+        hybridsub.refine_adaptive(F, where=[0], levels=1, **kwargs)
+    assert str(adaptive.value) == str(uniform.value)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(where=np.ones(3, bool), levels=1), r"one entry per face, shape \(4,\)"),
+    (dict(where=[0, 9], levels=1), r"where\[1\] = 9 is not a face"),
+    (dict(where=[0.5], levels=1), "boolean mask of the 4 faces or a 1-D array of face indices"),
+    (dict(where=[[0]], levels=1), "boolean mask of the 4 faces or a 1-D array of face indices"),
+    (dict(where=[0], levels=-1), "levels must be a non-negative integer"),
+    (dict(where=[0]), "needs levels="),
+    (dict(levels=1), "needs where="),
+    (dict(V=TETV, tolerance=0.0), "tolerance must be positive and finite"),
+    (dict(V=TETV, tolerance=-1.0), "tolerance must be positive and finite"),
+    (dict(V=TETV, tolerance=float("nan")), "tolerance must be positive and finite"),
+    (dict(V=TETV, tolerance=float("inf")), "tolerance must be positive and finite"),
+    (dict(V=TETV, tolerance="abc"), "percentage"),
+    (dict(V=TETV, tolerance="-1%"), "tolerance must be positive and finite"),
+    (dict(V=TETV, tolerance=None), "needs both V= and tolerance="),
+    (dict(V=TETV, tolerance=0.1, max_levels=-1), "max_levels must be a non-negative integer"),
+    (dict(V=TETV, tolerance=0.1, where=[0], levels=1), "not both"),
+])
+def test_adaptive_arguments_refused_by_name(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        hybridsub.refine_adaptive(TET, **kwargs)
+
+
+def test_sqrt3_with_a_boundary_is_refused():
+    with pytest.raises(ValueError, match="needs a closed mesh"):
+        hybridsub.refine_adaptive([[0, 1, 2], [0, 2, 3]], where=[0], levels=1, scheme="sqrt3")
+
+
+def test_inputs_are_not_written_to():
+    V, F = ms.icosahedron()
+    V0, F0 = V.copy(), F.copy()
+    V.setflags(write=False)
+    F.setflags(write=False)
+    hybridsub.subdivide_adaptive(V, F, tolerance="2%", scheme="loop")
+    hybridsub.refine_adaptive(F, where=np.zeros(len(F), bool), levels=1)
+    assert np.array_equal(V, V0) and np.array_equal(F, F0)
+
+
+# ------------------------------------------------------------------------------------------
+# The command line
+# ------------------------------------------------------------------------------------------
+
+
+def test_cli_subdivide_to_a_tolerance(tmp_path, capsys):
+    from hybridsub._app.cli import main
+    src = os.path.join(DATA, "cube-meshed.off")
+    out = tmp_path / "a.obj"
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.5%", "--feature-angle", "30"]) == 0
+    err = capsys.readouterr().err
+    assert "adaptive to" in err and "error" in err
+    m = hybridsub.read_mesh(str(out))
+    given = hybridsub.read_mesh(src)
+    V, F = given.vertices, given.faces
+    feat = hybridsub.detect_features(V, F, 30)
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, feat.sharp_edges, tolerance="0.5%", corners=feat.corners)
+    assert np.array_equal(m.faces, F2) and np.allclose(m.vertices, V2, atol=1e-9)
+    assert len(m.sharp_edges) > 0  # the creases written back
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.5%", "--levels", "2"]) == 1
+    assert "exclude each other" in capsys.readouterr().err
+    for bad in ("0", "-1%", "abc", "inf"):
+        with pytest.raises(SystemExit) as e:
+            main(["subdivide", src, "-o", str(out), "--tolerance", bad])
+        assert e.value.code == 2
+
+
+def test_cli_info_reports_adaptive(capsys):
+    from hybridsub._app.cli import main
+    src = os.path.join(DATA, "icosahedron.off")
+    assert main(["info", src]) == 0
+    assert "add --tolerance" in capsys.readouterr().out
+    assert main(["info", src, "--tolerance", "1%", "--scheme", "loop", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)["adaptive"]
+    m = hybridsub.read_mesh(src)
+    V2, F2 = hybridsub.subdivide_adaptive(m.vertices, m.faces, tolerance="1%", scheme="loop")
+    assert rep["faces"] == len(F2) and rep["error"] <= rep["tolerance"]
+
+
+@cfg(10)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_tolerance_refinement_is_crack_free_and_exact(mesh, data):
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    tol = data.draw(st.sampled_from(["2%", "5%"]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance=tol, max_levels=2, scheme=scheme, **tags)
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance=tol, max_levels=2, scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces)
+    check_crack_free(V, F, r)
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    for j in range(int(r.vertex_level.max(initial=0)) + 1):
+        sel = np.flatnonzero((r.vertex_level == j) & np.isin(np.arange(r.n_vertices), F2))
+        if len(sel):
+            L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max() <= 1e-9, (j, float(d.max()), int((d > 1e-9).sum()), len(d))
