@@ -51,8 +51,9 @@ def _usage_files():
 SETUP = {"usage.md": _usage_files}
 
 #: Pages whose blocks start worker processes (a local Dask cluster), fit surfaces to
-#: thousands of points or run 300 steps of gradient descent: run with ``-m slow``.
-SLOW = {"batch.md", "fitting.md", "differentiable.md"}
+#: thousands of points, refine fandisk to a tolerance or run 300 steps of gradient descent:
+#: run with ``-m slow``.
+SLOW = {"adaptive.md", "batch.md", "fitting.md", "differentiable.md"}
 
 
 @pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW else p
