@@ -4,7 +4,7 @@ A kernel is compiled on the first call that needs it and cached on disk (Numba's
 ``NUMBA_CACHE_DIR``, else ``__pycache__``), so without a warm-up the first call of each kind
 waits for its kernels. :func:`warm_up` makes one small call of every kind (each scheme and
 tag, one thread and all threads, values and matrices, UVs, limits, the limit surface, fitting,
-multiresolution), so that afterwards no call compiles.
+multiresolution, adaptive refinement), so that afterwards no call compiles.
 
 >>> from hybridsub._app.warmup import JOBS
 >>> "limit surface" in dict(JOBS)
@@ -136,6 +136,16 @@ def _fitting() -> None:
     r.reconstruct(coarse, details)
 
 
+def _adaptive() -> None:
+    import hybridsub
+
+    V, F, edges, corners = _small()
+    for scheme in ("hybrid", "sqrt3", "loop"):
+        tags = {} if scheme == "sqrt3" else dict(sharp_edges=edges, corners=corners)
+        hybridsub.refine_adaptive(F, where=np.arange(len(F) // 4), levels=2, scheme=scheme, **tags)
+        hybridsub.subdivide_adaptive(V, F, tolerance="1%", max_levels=2, scheme=scheme, **tags)
+
+
 #: What ``hybridsub warmup`` runs, in order: (what, call).
 JOBS: list[tuple[str, Callable[[], None]]] = [
     ("refinement, one thread", _one_thread),
@@ -144,6 +154,7 @@ JOBS: list[tuple[str, Callable[[], None]]] = [
     ("limit positions and normals", _limits),
     ("limit surface", _surface),
     ("fitting and multiresolution", _fitting),
+    ("adaptive refinement", _adaptive),
 ]
 
 
