@@ -224,8 +224,14 @@ def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray,
     """(face, bary) of every vertex of the last of ``steps`` over the input faces ``F0``.
 
     ``steps`` are :class:`RefinementStep` objects (faces, matrix, face_parent); ``twin_of(F, n)``
-    gives a level's halfedge twins. Each vertex is reported on the first face (in face order)
-    of the finest level that uses it; a vertex no face uses gets face −1 and bary (1, 0, 0).
+    gives a level's halfedge twins. Each vertex is reported through the face of the finest
+    level that uses it whose chart holds it least unfolded (across the fewest edges of that
+    face's input face, then on the fewest of their lines, then the least far; the first such
+    face in face order): a corner
+    with two negative coordinates lies across a vertex of its input face, and round a vertex
+    whose faces do not add up to a plane the way across it is not unique, while a face that
+    holds the vertex within one edge of its input face names the one the refinement put it
+    in. A vertex no face uses gets face −1 and bary (1, 0, 0).
     """
     charts = FaceCharts(F0, n0, twin_of)
     for st in steps:
@@ -233,8 +239,16 @@ def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray,
     F, n, B, inface, twin0 = charts.F, charts.n, charts.B, charts.inface, charts.twin0
     flat = F.ravel()
     first = np.full(n, -1, np.int64)
-    order = np.arange(len(flat))[::-1]
-    first[flat[order]] = order  # the lowest corner index wins
+    if len(flat):
+        Bc = B.reshape(-1, 3)  # each corner over its face's input face
+        across = (Bc < -1e-9).sum(axis=1)  # edges of the input face it lies across: 2 is a vertex
+        on_line = (np.abs(Bc) <= 1e-9).sum(axis=1)  # on an edge's line: across it may pass a vertex
+        outside = np.round(np.minimum(Bc, 0.0).sum(axis=1), 9)
+        corner = np.arange(len(flat))
+        order = np.lexsort((corner, -outside, on_line, across, flat))  # by vertex, the best-held corner first
+        lead = np.ones(len(order), bool)
+        lead[1:] = flat[order[1:]] != flat[order[:-1]]
+        first[flat[order[lead]]] = order[lead]
     face = np.full(n, -1, np.int64)
     bary = np.zeros((n, 3))
     bary[:, 0] = 1.0
