@@ -152,7 +152,7 @@ def test_an_edited_rule_changes_the_package_as_an_empty_cache_does(tmp_path):
     code = OUTPUTS.format(root=str(src))
     warm = tmp_path / "warm"
     before = _run(code, src, warm)
-    rules = src / "hybridsub" / "_rules" / "refinement.py"
+    rules = src / "hybridsub" / "_rules" / "step_rules.py"
     _edit(rules, "(1.0 - s) * 0.375", "(1.0 - s) * 0.4")
     _edit(rules, "return 1.0 - n * smooth_w, smooth_w, 0.0, 0.0",
           "return 1.0 - n * (0.5 * smooth_w), 0.5 * smooth_w, 0.0, 0.0")
