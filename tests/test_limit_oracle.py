@@ -7,6 +7,8 @@
     and the chart's barycentric maps, not the descent), tends to ``evaluate`` geometrically.
 """
 
+import os
+
 import numpy as np
 import pytest
 
@@ -82,6 +84,20 @@ def test_deep_levels_round_valence_five_vertices(scheme, levels):
     r = hybridsub.refine(F, levels=levels, scheme=scheme)
     got = hybridsub.LimitSurface(V, F, scheme=scheme).evaluate(*r.vertex_origin)
     want = hybridsub.limit_positions(V, F, levels=levels, scheme=scheme)
+    assert np.abs(got - want).max() <= 1e-12 * _diag(V)
+
+
+@pytest.mark.xfail(strict=True, reason="known defect (issue 30): on this random hybrid mesh with semi-sharp "
+                   "creases and sharp faces, 3 of its level-1 vertices evaluate up to 0.05 off their limit positions")
+def test_a_hybrid_mesh_with_semisharp_creases_and_sharp_faces():
+    """Found by the adaptive refinement's property test (hypothesis): ``evaluate`` at
+    ``vertex_origin`` against ``limit_positions`` at level 1, the uniform path."""
+    d = np.load(os.path.join(os.path.dirname(__file__), "data", "hybrid_semisharp_sharp_faces.npz"))
+    V, F = d["V"], d["F"]
+    tags = dict(sharp_edges=d["sharp_edges"], sharpness=d["sharpness"], sharp_faces=d["sharp_faces"])
+    r = hybridsub.refine(F, levels=1, scheme="hybrid", n_vertices=len(V), **tags)
+    got = hybridsub.LimitSurface(V, F, scheme="hybrid", **tags).evaluate(*r.vertex_origin)
+    want = hybridsub.limit_positions(V, F, levels=1, scheme="hybrid", **tags)
     assert np.abs(got - want).max() <= 1e-12 * _diag(V)
 
 

@@ -220,6 +220,27 @@ class FaceCharts:
         return onto_input_faces(self.inface[faces], b, self.twin0, self.F0)
 
 
+def best_held_corners(F: np.ndarray, B: np.ndarray, n: int) -> np.ndarray:
+    """For each of ``n`` vertices, the corner (flat index into ``F``) whose chart ``B`` (m, 3,
+    3) holds it least unfolded: across the fewest edges of its face's input face, then on the
+    fewest of their lines, then the least far, then the first; −1 for a vertex no face uses.
+    A corner with two negative coordinates lies across a vertex of its input face, and round a
+    vertex whose faces do not add up to a plane the way across it is not unique."""
+    flat = F.ravel()
+    first = np.full(n, -1, np.int64)
+    if len(flat):
+        Bc = B.reshape(-1, 3)
+        across = (Bc < -1e-9).sum(axis=1)
+        on_line = (np.abs(Bc) <= 1e-9).sum(axis=1)
+        outside = np.round(np.minimum(Bc, 0.0).sum(axis=1), 9)
+        corner = np.arange(len(flat))
+        order = np.lexsort((corner, -outside, on_line, across, flat))  # by vertex, the best-held first
+        lead = np.ones(len(order), bool)
+        lead[1:] = flat[order[1:]] != flat[order[:-1]]
+        first[flat[order[lead]]] = order[lead]
+    return first
+
+
 def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray, np.ndarray]:
     """(face, bary) of every vertex of the last of ``steps`` over the input faces ``F0``.
 
@@ -238,17 +259,7 @@ def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray,
         charts.step(st)
     F, n, B, inface, twin0 = charts.F, charts.n, charts.B, charts.inface, charts.twin0
     flat = F.ravel()
-    first = np.full(n, -1, np.int64)
-    if len(flat):
-        Bc = B.reshape(-1, 3)  # each corner over its face's input face
-        across = (Bc < -1e-9).sum(axis=1)  # edges of the input face it lies across: 2 is a vertex
-        on_line = (np.abs(Bc) <= 1e-9).sum(axis=1)  # on an edge's line: across it may pass a vertex
-        outside = np.round(np.minimum(Bc, 0.0).sum(axis=1), 9)
-        corner = np.arange(len(flat))
-        order = np.lexsort((corner, -outside, on_line, across, flat))  # by vertex, the best-held corner first
-        lead = np.ones(len(order), bool)
-        lead[1:] = flat[order[1:]] != flat[order[:-1]]
-        first[flat[order[lead]]] = order[lead]
+    first = best_held_corners(F, B, n)
     face = np.full(n, -1, np.int64)
     bary = np.zeros((n, 3))
     bary[:, 0] = 1.0

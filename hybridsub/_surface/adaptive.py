@@ -16,6 +16,7 @@ import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
 from .._refiner import FaceCharts, Refinement, refine
+from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement, refine_region
 from .._topology import build_level
 from .._typing import ArrayLike, LoopWeights, Scheme
@@ -111,12 +112,8 @@ class Criterion:
 
     def _limits(self, mesh: AdaptiveMesh, faces: np.ndarray, vertices: np.ndarray) -> None:
         """Limit positions of ``vertices``, placed through the charts of ``faces`` (each vertex
-        through the first of them that uses it)."""
-        Fv = mesh.faces[faces]
-        first = np.full(mesh.n_vertices, -1, np.int64)
-        flat = Fv.ravel()
-        first[flat[::-1]] = np.arange(len(flat))[::-1]
-        at = first[vertices]
+        through the one that holds it least unfolded, as ``vertex_origin`` does)."""
+        at = best_held_corners(mesh.faces[faces], self.charts.B[faces], mesh.n_vertices)[vertices]
         f, b = self.charts.points(faces[at // 3], np.eye(3)[at % 3])
         self.Q[vertices] = self.surface.evaluate(f, b)
         self.known[vertices] = True
@@ -164,6 +161,16 @@ class Criterion:
         local[ids] = np.arange(len(ids))
         h = (3 * af[:, None] + np.arange(3)).ravel()
         level = build_level(local[F[af]], len(ids))
+        # A star whose outer edges end the active region would be refined as if they were the
+        # boundary (split, not flipped; the boundary rules): its vertex needs every face across
+        # its star's edges active too, or the mesh's own boundary there.
+        cut = (level.twin < 0) & (mesh.twin[h] >= 0)
+        open_face = cut.reshape(-1, 3).any(axis=1)
+        bad = np.zeros(n, bool)
+        bad[F[af[open_face]].ravel()] = True
+        todo &= ~bad
+        if not todo.any():
+            return none
         owner = level.edge_owner
         hs = mesh.hsharp[h] if mesh.hsharp is not None and self.inp.scheme != "sqrt3" else np.zeros(len(h))
         esharp = np.where(level.twin[owner] < 0, np.inf, hs[owner])
