@@ -92,7 +92,7 @@ def test_deep_levels_round_valence_five_vertices(scheme, levels):
 def test_a_hybrid_mesh_with_semisharp_creases_and_sharp_faces():
     """Found by the adaptive refinement's property test (hypothesis): ``evaluate`` at
     ``vertex_origin`` against ``limit_positions`` at level 1, the uniform path."""
-    d = np.load(os.path.join(os.path.dirname(__file__), "data", "hybrid_semisharp_sharp_faces.npz"))
+    d = np.load(os.path.join(os.path.dirname(__file__), "data", "defects", "hybrid_semisharp_sharp_faces.npz"))
     V, F = d["V"], d["F"]
     tags = dict(sharp_edges=d["sharp_edges"], sharpness=d["sharpness"], sharp_faces=d["sharp_faces"])
     r = hybridsub.refine(F, levels=1, scheme="hybrid", n_vertices=len(V), **tags)
