@@ -3,6 +3,14 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# The property tests draw the same examples on every run (a green suite stays green until the
+# code changes); HYBRIDSUB_EXPLORE=1 draws fresh ones, to hunt for new counterexamples
+# (with HYBRIDSUB_PROPERTY_SCALE=10 for ten times as many).
+settings.register_profile("repeatable", derandomize=True, print_blob=True)
+settings.register_profile("explore", derandomize=False, print_blob=True)
+settings.load_profile("explore" if os.environ.get("HYBRIDSUB_EXPLORE") == "1" else "repeatable")
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 sys.path.insert(0, os.path.dirname(__file__))

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import hybridsub
 
-SETTINGS = settings(max_examples=20, deadline=None, derandomize=False,
+SETTINGS = settings(max_examples=20, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                            HealthCheck.filter_too_much])
 

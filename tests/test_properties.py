@@ -27,7 +27,7 @@ SCALE = int(os.environ.get("HYBRIDSUB_PROPERTY_SCALE", "1"))
 
 
 def cfg(n):
-    return settings(max_examples=n * SCALE, deadline=None, derandomize=False,
+    return settings(max_examples=n * SCALE, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                            HealthCheck.filter_too_much])
 

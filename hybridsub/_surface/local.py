@@ -134,7 +134,9 @@ class _LimitRows:
         self.ext_prev = None
         self.not_converged = 0
 
-    def update(self, plan: LimitPlan, st: _Stars, active: np.ndarray, last: bool):
+    def update(self, plan: LimitPlan, st: _Stars, active: np.ndarray, last: bool, trusted: np.ndarray):
+        """``trusted``: per centre, whether the last three steps were made from settled tags
+        (only then is the history a geometric tail to extrapolate)."""
         todo = np.flatnonzero(active & self.need)
         if not len(todo):
             return
@@ -150,7 +152,7 @@ class _LimitRows:
             self.need[fixed] = False
         moving = todo[~stat]
         if len(moving) and self.hist[0] is not None:
-            self._extrapolate(cur, moving, plan.settled[cl[moving]], last)
+            self._extrapolate(cur, moving, trusted[moving], last)
         self.hist = [cur, self.hist[0]]
 
     def _extrapolate(self, cur, moving, settled_moving, last):
@@ -197,7 +199,9 @@ class _SectorNormals:
         self.tol = tol
         self.max_levels = max_levels
 
-    def update(self, lvl: Level, plan: LimitPlan, st: _Stars, active: np.ndarray, lev: int, last: bool):
+    def update(self, lvl: Level, plan: LimitPlan, st: _Stars, active: np.ndarray, lev: int, last: bool,
+               trusted: np.ndarray):
+        """``trusted``: per centre, whether the last two steps were made from settled tags."""
         nc = len(self.need)
         sec = plan.sectors
         owner = np.full(st.n, -1, np.int64)
@@ -215,8 +219,7 @@ class _SectorNormals:
         change = np.zeros(nc)
         tg = self.targets
         np.maximum.at(change, self.target_centre, np.abs(self.est[tg] - self.prev[tg]).max(axis=1))
-        settled = np.zeros(nc, dtype=bool)
-        settled[active] = plan.settled[st.centre[active]]
+        settled = trusted & active
         # Fan normals (darts, mixed vertices) creep towards their limit like 1/levels:
         # they stop after FAN_LEVELS levels (docs/limit.md).
         uses_fan = np.bincount(sec_c[moving_sec & ~robust], minlength=nc) > 0
@@ -241,14 +244,22 @@ def refine_locally(level: Level, tagged, face_sharp, corner, scheme, loop_weight
     nrm = _SectorNormals(plan0, centers, tol, max_levels) if X is not None else None
     need_nrm = nrm.need if nrm is not None else np.zeros(nc, dtype=bool)
     active = rows.need | need_nrm
+    # A star's positions converge geometrically only once its tags stop changing: count the
+    # steps made from settled tags (with integer sharpness a vertex can stay put for a few
+    # levels as a corner and then move, which must not read as converged).
+    was_settled = plan0.settled[centers].copy()
+    settled_steps = np.zeros(nc, np.int64)
     for lev in range(1, max_levels + 1):
         st = _step(_drop(st, active), active, is_corner_c, scheme, loop_weights)
+        settled_steps = np.where(was_settled, settled_steps + 1, 0)
         lvl, plan = _plan_stars(st, active, is_corner_c, scheme, loop_weights)
+        was_settled = np.zeros(nc, dtype=bool)
+        was_settled[active] = plan.settled[st.centre[active]]
         last = lev == max_levels
         if want_rows:
-            rows.update(plan, st, active, last)
+            rows.update(plan, st, active, last, settled_steps >= 3)
         if nrm is not None and (active & nrm.need).any():
-            nrm.update(lvl, plan, st, active, lev, last)
+            nrm.update(lvl, plan, st, active, lev, last, settled_steps >= 2)
         active = active & (rows.need | need_nrm)
         if not active.any():
             break
