@@ -37,18 +37,38 @@ def diagonal(V):
     return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
 
 
+def _piece_of_vertices(F0, faces, face_parent, n):
+    """The connected piece of the input (``F0``) each vertex of ``faces`` lies in, through the
+    input face its faces descend from (−1: unused)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    m = len(F0)
+    A = sp.coo_matrix((np.ones(3 * m), (np.repeat(np.arange(m), 3), F0.ravel())))
+    _, piece = connected_components(A @ A.T, directed=False)
+    out = np.full(n, -1, np.int64)
+    out[faces.ravel()] = np.repeat(piece[face_parent], 3)
+    return out
+
+
 def uniform_match(V, F, tags, scheme, r, X):
     """For each level j, the uniform level-j index of every adaptive vertex of level j (by
-    position); asserts each lies on one, to 1e-12 × the diagonal."""
+    position, within the same connected piece of the input: pieces may touch at coincident
+    vertices); asserts each lies on one, to 1e-12 × the diagonal."""
     tol = 1e-12 * diagonal(V)
     top = int(r.vertex_level.max(initial=0))
     index = np.full(len(X), -1, np.int64)
+    apart = 10.0 * (diagonal(V) + 1.0)
+    piece = _piece_of_vertices(F, r.faces, r.face_parent, len(X))
     for j in range(top + 1):
         sel = np.flatnonzero(r.vertex_level == j)
         if not len(sel):
             continue
-        U = hybridsub.refine(F, levels=j, scheme=scheme, n_vertices=len(V), **tags).apply(V) if j else V
-        d, idx = cKDTree(U).query(X[sel])
+        if j:
+            u = hybridsub.refine(F, levels=j, scheme=scheme, n_vertices=len(V), **tags)
+            U, upiece = u.apply(V), _piece_of_vertices(F, u.faces, u.face_parent, u.n_vertices)
+        else:
+            U, upiece = V, _piece_of_vertices(F, F, np.arange(len(F)), len(V))
+        d, idx = cKDTree(np.column_stack([U, apart * upiece])).query(np.column_stack([X[sel], apart * piece[sel]]))
         assert d.max() <= tol, (j, float(d.max()))
         index[sel] = idx
     return index

@@ -32,6 +32,8 @@ def _tags(V, F, kind, rng):
         return {}
     if kind == "semisharp":
         return dict(sharp_edges=feat.sharp_edges, sharpness=rng.uniform(0.2, 3.0, len(feat.sharp_edges)))
+    if kind == "integer-sharpness":  # corners for a level or two, then moving
+        return dict(sharp_edges=feat.sharp_edges, sharpness=rng.choice([1.0, 2.0, 3.0], len(feat.sharp_edges)))
     return dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
 
 
@@ -40,8 +42,8 @@ def _vertex_cases(slow):
                                                                      "elephant-with-holes", "fandisk"] if slow else [])
     out = []
     for name in meshes:
-        for scheme, kinds in (("hybrid", ["none", "creases", "semisharp", "sharp-faces"]),
-                              ("loop", ["none", "creases", "semisharp"]), ("sqrt3", ["none"])):
+        for scheme, kinds in (("hybrid", ["none", "creases", "semisharp", "integer-sharpness", "sharp-faces"]),
+                              ("loop", ["none", "creases", "semisharp", "integer-sharpness"]), ("sqrt3", ["none"])):
             for kind in kinds:
                 if kind == "sharp-faces" and name in ("mesh_with_border", "cube-meshed", "elephant-with-holes",
                                                       "fandisk") and not (slow and name == "mesh_with_border"):
@@ -107,6 +109,31 @@ def test_a_hybrid_mesh_with_semisharp_creases_and_sharp_faces():
         P = hybridsub.refine(F, levels=levels, scheme="hybrid", n_vertices=len(V), **tags).apply(V)
         gaps.append(np.abs(P[moved] - want[moved]).max())
     assert all(b < 0.7 * a for a, b in zip(gaps, gaps[1:])), gaps
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid", "hybrid-mixed"])
+@pytest.mark.parametrize("sharpness", [1.0, 2.0, 3.0])
+def test_limit_positions_with_integer_sharpness_are_the_limit_of_refinement(scheme, sharpness):
+    """Every edge of the octahedron semi-sharp with an integer sharpness: its vertices are
+    corners for ``sharpness`` levels, then smooth (``hybrid-mixed``: sharp and smooth faces
+    in a checkerboard, every vertex mixed, where no stationary mask exists). The refined
+    positions of its vertices (uniform refinement, no limit code) close in on
+    ``limit_positions`` geometrically, and their Aitken extrapolation agrees with it (an
+    oracle independent of the local refinement the limit positions come from)."""
+    V, F = load_mesh("octahedron")
+    E = np.unique(np.sort(np.stack([F, np.roll(F, -1, axis=1)], -1).reshape(-1, 2), axis=1), axis=0)
+    kw = dict(scheme=scheme.split("-")[0], sharp_edges=E, sharpness=np.full(len(E), sharpness))
+    if scheme == "hybrid-mixed":
+        kw["sharp_faces"] = np.flatnonzero(np.prod(V[F].mean(axis=1), axis=1) > 0)
+        assert len(kw["sharp_faces"]) == 4
+    want = hybridsub.limit_positions(V, F, **kw)
+    P = [hybridsub.refine(F, levels=L, n_vertices=len(V), **kw).apply(V)[:len(V)] for L in (5, 6, 7)]
+    gaps = [np.abs(p - want).max() for p in P]
+    assert gaps[2] < 0.7 * gaps[1] < 0.49 * gaps[0], gaps
+    d1, d2 = P[1] - P[0], P[2] - P[1]
+    rho = np.linalg.norm(d2, axis=1) / np.linalg.norm(d1, axis=1)
+    aitken = P[2] + (rho / (1 - rho))[:, None] * d2
+    assert np.abs(aitken - want).max() < 0.25 * gaps[2], (gaps, np.abs(aitken - want).max())
 
 
 @pytest.mark.slow
