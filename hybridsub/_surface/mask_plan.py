@@ -10,6 +10,7 @@ semi-sharp; a sector has stationary tangent masks by its kind (``SEC_*``). Every
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -38,7 +39,12 @@ class LimitPlan:
     settled: np.ndarray  # (n,) no incident semi-sharp crease (all are 0 or infinite)
     rows: tuple  # COO (row, col, weight) of the limit masks of the pos_ok vertices
     sec_kind: np.ndarray  # (s,) SEC_* code
-    tangents: tuple  # COO (sector, col, w1, w2) of the two tangent masks (SEC_* 0-5)
+    loop_weights: str
+
+    @cached_property
+    def tangents(self) -> tuple:
+        """COO (sector, col, w1, w2) of the two tangent masks (SEC_* 0-5); only normals need them."""
+        return _tangent_rows(self.sectors, self.sec_kind, self.loop_weights)
 
     def limit_csr(self, n: int, only: np.ndarray | None = None) -> sp.csr_matrix:
         """The limit masks as an (n, n) CSR matrix; with ``only``, just those vertices' rows."""
@@ -106,8 +112,7 @@ def plan_level(level: Level, esharp: np.ndarray, face_sharp: np.ndarray, corner:
     vc = _classify(level, sec, esharp, face_sharp, corner, scheme, loop_weights)
     rows = _limit_rows(level, sec, vc, esharp, scheme, loop_weights)
     kind = _sector_kinds(sec, vc, face_sharp, scheme)
-    tangents = _tangent_rows(sec, kind, loop_weights)
-    return LimitPlan(sec, vc.pos_ok, vc.settled, rows, kind, tangents)
+    return LimitPlan(sec, vc.pos_ok, vc.settled, rows, kind, loop_weights)
 
 
 @dataclass(frozen=True, eq=False)
@@ -168,7 +173,8 @@ class _Coo:
             part.append(np.asarray(col, dtype))
 
     def arrays(self) -> tuple:
-        return tuple(np.concatenate(p).astype(d) if p else np.zeros(0, d) for p, d in zip(self.parts, self.dtypes))
+        return tuple(np.concatenate(p).astype(d, copy=False) if p else np.zeros(0, d)
+                     for p, d in zip(self.parts, self.dtypes))
 
 
 def _ring_masks(coo: _Coo, sec: Sectors, ss_all: np.ndarray, row_of, ring_len, masks):

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._topology import Level, Sectors, next_halfedge, prev_halfedge
+from .._topology import Level, Sectors
+from ._normal_kernels import fan_area_vectors
 from .mask_plan import SEC_CORNER, SEC_FAN, SEC_TRANSIENT, LimitPlan
 
 
@@ -22,15 +23,22 @@ def unit(A: np.ndarray) -> np.ndarray:
 
 def fan_normals(level: Level, sec: Sectors, X: np.ndarray) -> np.ndarray:
     """Area vector of each sector's control fan, Σ (p_j − v) × (p_{j+1} − v)."""
-    F = level.faces.ravel()
-    h = sec.slots
-    v = X[F[h]]
-    a = X[F[next_halfedge(h)]] - v
-    b = X[F[prev_halfedge(h)]] - v
-    cr = np.cross(a, b)
-    out = np.zeros((len(sec.vertex), 3))
-    if len(h):
-        np.add.at(out, sec.slot_sector, cr)
+    return fan_area_vectors(np.ascontiguousarray(level.faces, dtype=np.int64),
+                            np.ascontiguousarray(sec.slots, dtype=np.int64),
+                            np.ascontiguousarray(sec.slot_sector, dtype=np.int64),
+                            np.ascontiguousarray(X, dtype=np.float64), len(sec.vertex))
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of two (k, 3) arrays (``np.cross`` without its generality).
+
+    >>> cross(np.array([[1.0, 0, 0]]), np.array([[0.0, 1, 0]])).tolist()
+    [[0.0, 0.0, 1.0]]
+    """
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     return out
 
 
@@ -38,7 +46,7 @@ def sector_normals(level: Level, plan: LimitPlan, X: np.ndarray) -> np.ndarray:
     """Unit normal of every sector whose kind is not SEC_TRANSIENT (rows of those: zero)."""
     T1, T2 = plan.tangent_csr(level.n_vertices)
     t1, t2 = T1 @ X, T2 @ X
-    nrm = np.cross(t1, t2)
+    nrm = cross(t1, t2)
     fan = fan_normals(level, plan.sectors, X)
     kind = plan.sec_kind
     corner = kind == SEC_CORNER

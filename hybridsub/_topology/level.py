@@ -78,21 +78,25 @@ class Level:
     def n_edges(self) -> int:
         return self.edge_owner.shape[0]
 
-    @property
+    @cached_property
     def edge_vertices(self) -> np.ndarray:
         """(ne, 2) edges as vertex pairs in their owner halfedge's orientation."""
         h = self.edge_owner
         f, i = h // 3, h % 3
-        return np.stack([self.faces[f, i], self.faces[f, (i + 1) % 3]], axis=1)
+        ev = np.stack([self.faces[f, i], self.faces[f, (i + 1) % 3]], axis=1)
+        ev.flags.writeable = False  # computed once, shared
+        return ev
 
     @property
     def boundary_edge(self) -> np.ndarray:
         return self.twin[self.edge_owner] < 0
 
-    @property
+    @cached_property
     def valence(self) -> np.ndarray:
         """(n,) number of distinct neighbours of each vertex."""
-        return np.bincount(self.edge_vertices.ravel(), minlength=self.n_vertices)
+        val = np.bincount(self.edge_vertices.ravel(), minlength=self.n_vertices)
+        val.flags.writeable = False  # computed once, shared
+        return val
 
     @property
     def by_origin(self) -> np.ndarray:
