@@ -15,7 +15,9 @@ What it measures (all in this one run, on this machine; see docs/performance.md)
 * applying a precomputed composite matrix (one frame, and 100 frames at once) against SciPy's
   ``S @ V`` and against re-running ``subdivide``; the copy floor (``V2.copy(); F2.copy()``);
 * the first call in a fresh process with a warm and with an empty Numba cache;
-* the peak memory of ``subdivide`` against the size of its output arrays.
+* the peak memory of ``subdivide`` against the size of its output arrays;
+* the vertex path (refinement, limit positions and normals) against Adobe Lagrange
+  (benchmarks/lagrange_peer.py).
 
 Every timing is the median (and min) of several warm runs: one untimed warm-up call, then
 each run prepares its input outside the timed region, times the call alone with the garbage
@@ -44,6 +46,7 @@ from typing import Callable
 import numpy as np
 
 from _bench import FIRST_CALL, HERE, ROOT, Timing, child_env, cpu_name, fresh_process, load, measure, tags  # noqa: E402
+import lagrange_peer  # noqa: E402
 import per_core  # noqa: E402
 
 import hybridsub  # noqa: E402  (_bench put this checkout's package first)
@@ -557,7 +560,7 @@ class Run:
             return []
         return ["## Per core, then all cores (issue 18)", ""] + per_core.report(T, check, self.L) + [""]
 
-    def report(self, apply_rows, floor_rows, starts, mem_rows, core_rows=()) -> str:
+    def report(self, apply_rows, floor_rows, starts, mem_rows, core_rows=(), lagrange_rows=()) -> str:
         L, T = self.L, self.T
         md = [f"# hybridsub performance — `benchmarks/compare.py`{' --quick' if self.args.quick else ''}", ""]
         md += machine_lines(self.args, self.versions, self.load_at_start) + [""]
@@ -571,6 +574,9 @@ class Run:
             md += ["", "OpenSubdiv's parts (medians): " + "; ".join(
                 f"{k}: create {fmt_t(t.extra['create'])}, refine {fmt_t(t.extra['refine'])}, "
                 f"interpolate {fmt_t(t.extra['interpolate'])}" for k, t in osd)]
+
+        if lagrange_rows:
+            md += [""] + list(lagrange_rows)
 
         md += ["", "## Applying the precomputed composite matrix (animation frames)", ""]
         rows = []
@@ -646,8 +652,12 @@ def main(argv=None) -> int:
     log("timing first calls in fresh processes ...")
     starts = first_calls(repeat=max(3, min(args.repeat, 5)), cold_runs=1 if args.quick else 2)
     mem_rows = run.memory()
+    log("timing the vertex path against Adobe Lagrange ...")
+    lag_rows, why = lagrange_peer.run_section(run.L, args.repeat, args.budget)
+    if why:
+        run.skipped["lagrange"] = why
 
-    text = run.report(apply_rows, floor_rows, starts, mem_rows, core_rows)
+    text = run.report(apply_rows, floor_rows, starts, mem_rows, core_rows, lag_rows)
     print(text)
     if args.markdown:
         with open(args.markdown, "w") as fh:
