@@ -36,9 +36,10 @@ OK = 0
 ERR_SAME_DIRECTION = 1  # two halfedges u→w: non-manifold edge or inconsistent orientation
 ERR_MULTIPLE_TWINS = 2  # more than two halfedges on one edge
 
-#: Inputs smaller than this (faces or rows) run the serial twin of a threaded kernel:
-#: starting threads costs more than the work.
-PARALLEL_MIN = 20000
+#: Inputs smaller than this (faces or rows) run the serial twin of a threaded kernel: below
+#: it threads save a few milliseconds at most, and a first call would pay for compiling the
+#: threaded twins as well (docs/performance.md, first call).
+PARALLEL_MIN = 65536
 
 
 def use_threads(rows: int) -> bool:
