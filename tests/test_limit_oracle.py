@@ -215,3 +215,35 @@ def test_refinement_converges_to_the_surface_at_random_parameters(scheme, tags, 
     gaps = np.array(gaps) / _diag(V)
     rate = (gaps[-1] / gaps[0]) ** (1 / (levels[-1] - levels[0]))
     assert rate < 0.75 and np.all(np.diff(np.log(gaps)) < 0), gaps
+
+
+@pytest.mark.parametrize("name, scheme, levels", [("icosahedron", "sqrt3", 6), ("tetrahedron", "hybrid", 5)])
+def test_both_faces_of_an_edge_put_its_midpoint_on_one_surface_point(name, scheme, levels):
+    """The charts that follow each face of a refinement onto the input (``FaceCharts``, which
+    adaptive refinement measures its error through): an edge's midpoint, taken through either
+    of its two faces, is one point of the limit surface. √3's flips move faces round a vertex
+    level by level; a face left in the chart it started in ends up across the vertex, where
+    the way back onto an input face is not unique round a vertex whose faces do not add up to
+    a plane (the icosahedron's valence 5: the two sides then named points 6 % of the diagonal
+    apart)."""
+    from hybridsub._refiner.chart import FaceCharts
+
+    V, F = load_mesh(name)
+    kw = dict(scheme=scheme, sharp_edges=[[0, 1]]) if scheme == "hybrid" else dict(scheme=scheme)
+    r = hybridsub.refine(F, levels=levels, n_vertices=len(V), **kw)
+    charts = FaceCharts(F, len(V), lambda A, n: build_level(A, n).twin)
+    for st in r.steps:
+        charts.step(st)
+    twin = build_level(r.faces, r.n_vertices).twin
+    h = np.flatnonzero(twin > np.arange(len(twin)))
+    t = twin[h]
+
+    def midpoints(hh):
+        b = np.zeros((len(hh), 3))
+        b[np.arange(len(hh)), hh % 3] = 0.5
+        b[np.arange(len(hh)), (hh + 1) % 3] = 0.5
+        return charts.points(hh // 3, b)
+
+    s = hybridsub.LimitSurface(V, F, **kw)
+    gap = np.linalg.norm(s.evaluate(*midpoints(h)) - s.evaluate(*midpoints(t)), axis=1)
+    assert gap.max() <= 1e-9 * _diag(V), (int((gap > 1e-9 * _diag(V)).sum()), float(gap.max() / _diag(V)))

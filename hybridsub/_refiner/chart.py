@@ -213,6 +213,39 @@ class FaceCharts:
         self.inface = self.inface[parent]
         self.shape, self.F, self.n = shape1, st.faces, st.n_vertices
         self.twin = self.twin_of(self.F, self.n)
+        self._rehome()
+
+    def _rehome(self, tol: float = 1e-12) -> None:
+        """Faces whose centroid has left their input face across one edge move to the chart of
+        the input face across it. Faces drift round a vertex level by level (√3's flips); left
+        in the chart they started in, they would end up across the vertex, where the way back
+        onto an input face is not unique (a vertex whose faces do not add up to a plane)."""
+        for _ in range(8):
+            c = self.B.mean(axis=1)
+            j = np.argmin(c, axis=1)
+            r = np.arange(len(c))
+            cj = c[r, j]
+            others = np.sort(c, axis=1)[:, 1]
+            move = np.flatnonzero((cj < -tol) & (others >= -tol))
+            if not len(move):
+                return
+            t = self.twin0[3 * self.inface[move] + (j[move] + 1) % 3]
+            ok = t >= 0
+            move, t = move[ok], t[ok]
+            if not len(move):
+                return
+            jj, a = j[move][:, None], (t % 3)[:, None]
+            b = self.B[move]  # (k, 3 corners, 3)
+            k3 = np.arange(3)[None, :]
+            bj = np.take_along_axis(b, np.broadcast_to(jj[:, None], (len(move), 3, 1)), axis=2)[..., 0]
+            bj1 = np.take_along_axis(b, np.broadcast_to(((jj + 1) % 3)[:, None], (len(move), 3, 1)), axis=2)[..., 0]
+            bj2 = np.take_along_axis(b, np.broadcast_to(((jj + 2) % 3)[:, None], (len(move), 3, 1)), axis=2)[..., 0]
+            nb = np.empty_like(b)
+            rows = np.arange(len(move))[:, None]
+            for col, val in ((a, bj2 + bj), ((a + 1) % 3, bj1 + bj), ((a + 2) % 3, -bj)):
+                nb[rows, k3, np.broadcast_to(col, (len(move), 3))] = val
+            self.B[move] = nb
+            self.inface[move] = t // 3
 
     def points(self, faces: np.ndarray, bary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points ``bary`` (k, 3) over the current faces ``faces`` (k,) as (input face, bary)."""
