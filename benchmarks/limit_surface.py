@@ -4,7 +4,8 @@ usage: python benchmarks/limit_surface.py [--points N] [--seed S] [--repeat R] [
                                          [--reference tests/data/NAME.npz]
 
 Samples N random points (face, bary) of fandisk with its detected creases (30°), evaluates
-them with ``hybridsub.LimitSurface`` (``"loop"``, ``"hybrid"``) and with OpenSubdiv Bfr (Loop,
+them with ``hybridsub.LimitSurface`` (``"loop"``, ``"hybrid"``; ``"sqrt3"`` on the same points
+without the creases, which Kobbelt's scheme does not take) and with OpenSubdiv Bfr (Loop,
 its default approximation levels, ``benchmarks/peers/osd_bfr``, built by
 ``benchmarks/peers/build.sh``; skipped with a note when it is not built), and prints: setup
 time, the time of the first ``evaluate(..., derivatives=True)`` of the points (after a
@@ -77,9 +78,9 @@ def main():
     else:
         print("Bfr: benchmarks/peers/bin/osd_bfr not built (benchmarks/peers/build.sh); timing ours only")
     for scheme in a.schemes:
-        t_setup, s = median_time(lambda: hybridsub.LimitSurface(V, F, feat.sharp_edges, scheme=scheme), 1)
-        hybridsub.LimitSurface(V, F, feat.sharp_edges, scheme=scheme).evaluate(face[:8], bary[:8],
-                                                                               derivatives=True)  # compiles
+        edges = None if scheme == "sqrt3" else feat.sharp_edges  # Kobbelt's √3 has no feature tags
+        t_setup, s = median_time(lambda: hybridsub.LimitSurface(V, F, edges, scheme=scheme), 1)
+        hybridsub.LimitSurface(V, F, edges, scheme=scheme).evaluate(face[:8], bary[:8], derivatives=True)  # compiles
         t_first, _ = median_time(lambda: s.evaluate(face, bary, derivatives=True), 1)
         t_eval, (P, Du, Dv) = median_time(lambda: s.evaluate(face, bary, derivatives=True), a.repeat)
         line = (f"{scheme}: setup {t_setup:.3f} s, first evaluate {t_first:.3f} s ({a.points / t_first:.3g} points/s, "
