@@ -59,3 +59,150 @@ def _with_holes(r, F, L, d):
     t = _tags(d)
     t["boundary"] = "edge_only"
     return hybridsub.refine(F, levels=L, scheme="loop", **t).faces
+
+
+def _border():
+    return _mesh("mesh_with_border.off")
+
+
+def _lone_boundary_vertices(F, n):
+    twin_free = {}
+    for f in F:
+        for i in range(3):
+            e = tuple(sorted((f[i], f[(i + 1) % 3])))
+            twin_free[e] = twin_free.get(e, 0) + 1
+    on_b = np.zeros(n, bool)
+    on_b[np.array([e for e, c in twin_free.items() if c == 1]).ravel()] = True
+    return np.flatnonzero(on_b & (np.bincount(F.ravel(), minlength=n) == 1))
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_edge_and_corner_is_tagging_lone_boundary_vertices(scheme):
+    V, F = _border()
+    lone = _lone_boundary_vertices(F, len(V))
+    assert len(lone) == 2
+    a = hybridsub.subdivide(V, F, levels=2, scheme=scheme, boundary="edge_and_corner")
+    b = hybridsub.subdivide(V, F, levels=2, scheme=scheme, corners=lone)
+    assert np.array_equal(a[1], b[1]) and np.array_equal(a[0], b[0])
+    assert not np.array_equal(a[0], hybridsub.subdivide(V, F, levels=2, scheme=scheme)[0])
+    P = hybridsub.limit_positions(V, F, scheme=scheme, boundary="edge_and_corner")
+    assert np.array_equal(P[lone], V[lone])
+
+
+def test_edge_and_corner_sqrt3_pins_the_lone_vertices():
+    """Kobbelt's boundary with the lone boundary vertices pinned: they stay at every level."""
+    V, F = _border()
+    lone = _lone_boundary_vertices(F, len(V))
+    X, _ = hybridsub.subdivide(V, F, levels=3, scheme="sqrt3", boundary="edge_and_corner")
+    Y, _ = hybridsub.subdivide(V, F, levels=3, scheme="sqrt3")
+    assert np.array_equal(X[lone], V[lone]) and not np.array_equal(Y[lone], V[lone])
+    assert np.abs(X[len(V):] - Y[len(V):]).max() > 0  # the new points near them feel it
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "sqrt3", "loop"])
+def test_boundary_none_drops_the_faces_at_the_boundary(scheme):
+    V, F = _border()
+    X0, F0 = hybridsub.subdivide(V, F, levels=2, scheme=scheme)
+    X, F2 = hybridsub.subdivide(V, F, levels=2, scheme=scheme, boundary="none")
+    assert np.array_equal(X, X0)  # positions as edge_only
+    r = hybridsub.refine(F, levels=2, scheme=scheme)
+    on_b = np.zeros(len(V), bool)
+    on_b[_boundary_vertices(F, len(V))] = True
+    hole = on_b[F].any(axis=1)
+    assert np.array_equal(F2, F0[~hole[r.face_parent]])
+    assert np.array_equal(hybridsub.refine(F, levels=2, scheme=scheme, boundary="none").faces, F2)
+
+
+def _boundary_vertices(F, n):
+    c = {}
+    for f in F:
+        for i in range(3):
+            e = tuple(sorted((f[i], f[(i + 1) % 3])))
+            c[e] = c.get(e, 0) + 1
+    return np.unique(np.array([e for e, k in c.items() if k == 1]).ravel())
+
+
+def _corner_mesh():
+    V, F = _mesh("cube-meshed.off")
+    corner = np.flatnonzero((np.abs(V) > 0.999).sum(axis=1) == 3)
+    return V, F, corner
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_infinite_and_zero_corner_sharpness(scheme):
+    V, F, c = _corner_mesh()
+    sf = np.arange(0, len(F), 3)  # a mixed hybrid: some faces Loop's
+    kw = dict(levels=2, scheme=scheme, sharp_faces=sf if scheme == "hybrid" else None)
+    tagged = hybridsub.subdivide(V, F, corners=c, **kw)
+    assert np.array_equal(hybridsub.subdivide(V, F, corners=c, corner_sharpness=np.full(len(c), np.inf), **kw)[0],
+                          tagged[0])
+    assert np.array_equal(hybridsub.subdivide(V, F, corners=c, corner_sharpness=np.full(len(c), 12.0), **kw)[0],
+                          tagged[0])
+    assert np.array_equal(hybridsub.subdivide(V, F, corners=c, corner_sharpness=np.zeros(len(c)), **kw)[0],
+                          hybridsub.subdivide(V, F, **kw)[0])
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_fractional_corner_blends_the_first_step(scheme):
+    """0 < s < 1: the vertex's first point is s · corner + (1 − s) · its smooth point."""
+    V, F, c = _corner_mesh()
+    s = 0.3
+    X = hybridsub.subdivide(V, F, levels=1, scheme=scheme, corners=c, corner_sharpness=np.full(len(c), s))[0]
+    smooth = hybridsub.subdivide(V, F, levels=1, scheme=scheme)[0]
+    assert np.allclose(X[c], s * V[c] + (1 - s) * smooth[c], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_semi_sharp_corner_refines_to_its_limit(scheme):
+    """The refined positions of the old vertices converge to limit_positions, with corners of
+    sharpness 0.5, 1 and 2.5 (a corner for two levels, then blending)."""
+    V, F, c = _corner_mesh()
+    s = np.resize([0.5, 1.0, 2.5], len(c))
+    kw = dict(scheme=scheme, corners=c, corner_sharpness=s)
+    P = hybridsub.limit_positions(V, F, **kw)
+    err = []
+    for L in (4, 6):
+        X = hybridsub.subdivide(V, F, levels=L, **kw)[0]
+        err.append(np.abs(X[c] - P[c]).max())
+    assert err[1] < err[0] / 4 and err[1] < 2e-3
+    # sharper corners stay nearer their control point
+    d = np.linalg.norm(P[c] - V[c], axis=1)
+    assert d[s == 2.5].max() < d[s == 0.5].min()
+    M = hybridsub.limit_matrix(F, **kw)
+    assert np.allclose(M @ V, P, atol=1e-12)
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_semi_sharp_corners_are_symmetric(scheme):
+    """A mirror image refines to the mirror image (cube-meshed is symmetric in x)."""
+    V, F, c = _corner_mesh()
+    mirror = np.array([-1.0, 1, 1])
+    s = 1.5 + 0.0 * V[c, 0]
+    X, F2 = hybridsub.subdivide(V, F, levels=2, scheme=scheme, corners=c, corner_sharpness=s)
+    Y, G2 = hybridsub.subdivide(V * mirror, F[:, ::-1], levels=2, scheme=scheme, corners=c, corner_sharpness=s)
+    assert mesh_difference(Y * mirror, G2[:, ::-1], X, F2, tol=1e-12) is None
+    # the icosahedron with every vertex a corner of the same sharpness: all stay alike
+    V, F = _mesh("icosahedron.off")
+    c = np.arange(len(V))
+    P = hybridsub.limit_positions(V, F, scheme=scheme, corners=c, corner_sharpness=np.full(len(V), 1.5))
+    X = hybridsub.subdivide(V, F, levels=3, scheme=scheme, corners=c, corner_sharpness=np.full(len(V), 1.5))[0]
+    for Y in (P, X[: len(V)]):
+        r = np.linalg.norm(Y, axis=1)
+        assert np.ptp(r) < 1e-12 * r.max() and np.abs(Y.mean(axis=0)).max() < 1e-12 * r.max()
+    assert np.linalg.norm(P, axis=1)[0] < np.linalg.norm(V, axis=1)[0] - 1e-3  # and they moved
+
+
+def test_corner_sharpness_errors():
+    V, F, c = _corner_mesh()
+    with pytest.raises(MeshError, match="corner_sharpness 1 .*-1"):
+        hybridsub.subdivide(V, F, corners=c[:2], corner_sharpness=[1.0, -1.0])
+    with pytest.raises(MeshError, match=r"corners\[0\] = 100000"):
+        hybridsub.subdivide(V, F, corners=[100000], corner_sharpness=[1.0])
+    with pytest.raises(MeshError, match="one value per corner"):
+        hybridsub.subdivide(V, F, corners=c[:2], corner_sharpness=[1.0])
+    with pytest.raises(ValueError, match="without corners"):
+        hybridsub.subdivide(V, F, corner_sharpness=[1.0])
+    with pytest.raises(ValueError, match="boundary must be one of"):
+        hybridsub.subdivide(V, F, boundary="edges")
+    with pytest.raises(ValueError, match="sqrt3"):
+        hybridsub.subdivide(V, F, scheme="sqrt3", corners=c[:1], corner_sharpness=[0.5])
