@@ -223,9 +223,12 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
         sharp_faces = np.flatnonzero(np.isin(origin, sharp_faces))
     if boundary_corners:  # OpenSubdiv's VTX_BOUNDARY_EDGE_AND_CORNER
         extra = np.setdiff1d(boundary_corner_vertices(F), corners)
-        if corner_s is not None:  # the new ones are infinitely sharp
+        if corner_s is not None:  # all of them infinitely sharp (OpenSubdiv's SharpenBoundaryVertex)
             corner_s = np.concatenate([corner_s, np.full(len(extra), np.inf)])[np.argsort(np.r_[corners, extra])]
         corners = np.union1d(corners, extra)
+        if corner_s is not None:
+            corner_s[np.isin(corners, boundary_corner_vertices(F))] = np.inf
+            corner_s = corner_s if np.isfinite(corner_s).any() else None
         if len(extra):
             tag_notes.append(f"'interpolateboundary 2': {len(extra)} boundary vertices in a single face "
                              "made corners")
