@@ -16,13 +16,14 @@ Scheme = Literal["hybrid", "sqrt3", "loop"]
 LoopWeights = Literal["loop", "warren"]
 NonManifold = Literal["raise", "cut"]
 UVMode = Literal["linear", "smooth"]
+Boundary = Literal["edge_only", "edge_and_corner", "none"]
 #: Bytes, or a string such as ``"16G"`` or ``"none"`` (see ``set_memory_limit``).
 MemoryLimit = Union[int, float, str, None]
 
 #: The schemes, in the order the command line lists them.
 SCHEMES: tuple[str, ...] = get_args(Scheme)
 
-__all__ = ["ArrayLike", "NDArray", "np", "Scheme", "LoopWeights", "NonManifold", "UVMode", "MemoryLimit", "SCHEMES"]
+__all__ = ["ArrayLike", "NDArray", "np", "Scheme", "LoopWeights", "NonManifold", "UVMode", "Boundary", "MemoryLimit", "SCHEMES"]
 
 
 def __getattr__(name: str) -> Any:

@@ -148,11 +148,12 @@ t interpolateboundary 1/0/0 2
     assert m.faces.tolist() == [[0, 1, 2], [0, 2, 3]]  # negative indices are relative
     assert m.sharp_edges.tolist() == [[0, 1], [1, 2], [2, 3]]  # a chain of pairs; sharpness 0 is no crease
     assert m.sharpness.tolist() == [np.inf, np.inf, 1.5]
-    # corner 1 (sharpness 3: semi-sharp corners become corners, with a note), corner 2 has sharpness 0;
-    # interpolateboundary 2 makes vertices 1 and 3, each in a single face, corners too
+    # corner 1 (sharpness 3: semi-sharp), corner 2 has sharpness 0; interpolateboundary 2 makes
+    # vertices 1 and 3, each in a single face, infinitely sharp corners (OpenSubdiv's EDGE_AND_CORNER)
     assert m.corners.tolist() == [1, 3]
+    assert m.corner_sharpness is None
     notes = " ".join(m.notes)
-    assert "hole" in notes and "semi-sharp corners" in notes and "sharpness <= 0" in notes
+    assert "hole" in notes and "sharpness <= 0" in notes
     assert "interpolateboundary 2" in notes
 
 

@@ -436,6 +436,10 @@ def _add_subdivide(sub) -> None:
     s.add_argument("--non-manifold", choices=("raise", "cut"), default="raise", dest="non_manifold",
                    help="edges in three or more faces, or inconsistently oriented: refuse (raise, the default) or cut "
                         "the mesh along them (cut; the pieces meet at creases)")
+    s.add_argument("--boundary", choices=("edge_only", "edge_and_corner", "none"), default="edge_only",
+                   help="OpenSubdiv's boundary interpolation: the boundary is a crease (edge_only, the default); its "
+                        "vertices in one face are corners too (edge_and_corner); or as edge_only with the faces at "
+                        "the boundary left out (none)")
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
     s.add_argument("--ascii", action="store_true", help="PLY output in ASCII instead of binary")
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")

@@ -54,6 +54,8 @@ class FileOptions:
         reading), ``--no-tags``, ``--ascii`` (on writing).
     non_manifold : {"raise", "cut"}
         ``--non-manifold``: as :func:`hybridsub.subdivide`'s ``non_manifold``.
+    boundary : {"edge_only", "edge_and_corner", "none"}
+        ``--boundary``: as :func:`hybridsub.subdivide`'s ``boundary``.
     force : bool
         Run even if the memory estimate exceeds the memory at hand (and lift the library's limit).
     quiet : bool
@@ -87,6 +89,7 @@ class FileOptions:
     triangulate: bool = False
     weld: bool = False
     non_manifold: str = "raise"
+    boundary: str = "edge_only"
     no_tags: bool = False
     ascii: bool = False
     force: bool = False
@@ -105,6 +108,7 @@ class FileFeatures:
     sharp_faces: np.ndarray
     corners: np.ndarray
     summary: str
+    corner_sharpness: np.ndarray | None = None  # beside corners, None: all infinitely sharp
 
     @staticmethod
     def none(summary: str) -> FileFeatures:
@@ -112,8 +116,11 @@ class FileFeatures:
                             summary)
 
     def tags(self) -> dict:
-        return dict(sharp_edges=self.sharp_edges, sharpness=self.sharpness, sharp_faces=self.sharp_faces,
-                    corners=self.corners)
+        t = dict(sharp_edges=self.sharp_edges, sharpness=self.sharpness, sharp_faces=self.sharp_faces,
+                 corners=self.corners)
+        if self.corner_sharpness is not None:
+            t["corner_sharpness"] = self.corner_sharpness
+        return t
 
 
 @dataclass
@@ -159,8 +166,14 @@ class _Sources:
     edges: list = field(default_factory=list)
     sharpness: list = field(default_factory=list)
     corners: list = field(default_factory=list)
+    corner_sharpness: list = field(default_factory=list)  # beside each of corners (inf: infinite)
     sharp_faces: list = field(default_factory=list)
     names: list = field(default_factory=list)
+
+    def add_corners(self, c, s=None) -> None:
+        c = np.asarray(c, np.int64)
+        self.corners.append(c)
+        self.corner_sharpness.append(np.full(len(c), np.inf) if s is None else np.asarray(s, np.float64))
 
 
 def gather_features(opts: FileOptions, mesh: TaggedMesh, path: str) -> FileFeatures:
@@ -176,7 +189,7 @@ def gather_features(opts: FileOptions, mesh: TaggedMesh, path: str) -> FileFeatu
     if file_tags:
         src.edges.append(mesh.sharp_edges)
         src.sharpness.append(mesh.sharpness)
-        src.corners.append(mesh.corners)
+        src.add_corners(mesh.corners, mesh.corner_sharpness)
         src.sharp_faces.append(mesh.sharp_faces)
         src.names.append(f"tags in {os.path.basename(path)}")
     _read_tag_files(opts, mesh, path, edges.pairs, src)
@@ -221,7 +234,7 @@ def _read_tag_files(opts: FileOptions, mesh: TaggedMesh, path: str, pairs: np.nd
         src.sharp_faces.append(_read_indices(opts.sharp_faces_file, "face", "faces", m, path))
         src.names.append(os.path.basename(opts.sharp_faces_file))
     if opts.corners_file is not None:
-        src.corners.append(_read_indices(opts.corners_file, "vertex", "vertices", n, path))
+        src.add_corners(_read_indices(opts.corners_file, "vertex", "vertices", n, path))
         src.names.append(os.path.basename(opts.corners_file))
 
 
@@ -234,7 +247,7 @@ def _add_detected(mesh: TaggedMesh, path: str, angle: float, sharpness: float | 
     src.edges.append(feat.sharp_edges)
     src.sharpness.append(np.full(len(feat.sharp_edges), s_feat))
     if np.isinf(s_feat):
-        src.corners.append(feat.corners)
+        src.add_corners(feat.corners)
     # semi-sharp: no corner tags, which would pin the vertices while their creases round off
     src.names.append(f"dihedral angle > {angle:g}°" + ("" if np.isinf(s_feat) else f", sharpness {s_feat:g}"))
 
@@ -242,18 +255,21 @@ def _add_detected(mesh: TaggedMesh, path: str, angle: float, sharpness: float | 
 def _merged(src: _Sources, n: int, n_boundary: int) -> FileFeatures:
     edges, sharp = merge_edges(np.vstack(src.edges) if src.edges else np.empty((0, 2), np.int64),
                                np.concatenate(src.sharpness) if src.sharpness else np.empty(0), n)
-    c = np.unique(np.concatenate(src.corners)) if src.corners else np.empty(0, np.int64)
+    c, cs = (_io.corner_tags(np.concatenate(src.corners), np.concatenate(src.corner_sharpness)) if src.corners
+             else (np.empty(0, np.int64), None))
     sf = np.unique(np.concatenate(src.sharp_faces)) if src.sharp_faces else np.empty(0, np.int64)
     parts = [count_of(len(edges), "crease")]
     semi = int(np.isfinite(sharp).sum())
     if semi:
         parts[-1] += f" ({semi:,} semi-sharp)"
     parts.append(count_of(len(c), "corner"))
+    if cs is not None:
+        parts[-1] += f" ({int(np.isfinite(cs).sum()):,} semi-sharp)"
     if len(sf):
         parts.append(count_of(len(sf), "sharp face"))
     if n_boundary:
         parts.append(f"{count_of(n_boundary, 'boundary edge')} (creases too)")
-    return FileFeatures(edges, sharp, sf, c, f"features: {', '.join(parts)} — from {' + '.join(src.names)}")
+    return FileFeatures(edges, sharp, sf, c, f"features: {', '.join(parts)} — from {' + '.join(src.names)}", cs)
 
 
 def _read_indices(list_path: str, noun: str, plural: str, count: int, mesh_path: str) -> np.ndarray:
@@ -400,7 +416,7 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
     try:
         res = refine_by_level(X, mesh.faces, levels, scheme=scheme, loop_weights=opts.loop_weights,
                               on_level=bar.update, max_memory="none" if opts.force else None, **uv_args,
-                              non_manifold=opts.non_manifold, **feat.tags())
+                              non_manifold=opts.non_manifold, boundary=opts.boundary, **feat.tags())
     except MeshError as e:  # the library's advice in the command line's words
         raise PipelineError(f"{path}: " + str(e).replace('pass non_manifold="cut"', "pass --non-manifold cut")
                             .replace('with non_manifold="cut"', "with --non-manifold cut")) from None
@@ -424,6 +440,9 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
 
     if mesh.uv is not None:
         say(opts, "note: texture coordinates dropped: adaptive refinement does not refine face-varying data yet")
+    if feat.corner_sharpness is not None or opts.boundary != "edge_only":
+        raise PipelineError(f"{path}: adaptive refinement (--tolerance) takes neither semi-sharp corners nor "
+                            "--boundary yet; refine uniformly (--levels)")
     t = time.perf_counter()
     try:
         with warnings.catch_warnings(record=True) as caught:
@@ -467,4 +486,5 @@ def _refined_mesh(mesh: TaggedMesh, res, vc, keep_uv: bool, scheme: str) -> Tagg
     fm = None if mesh.face_material is None else mesh.face_material[res.face_parent]
     return TaggedMesh(V, res.faces, res.sharp_edges, res.sharpness, res.corners,
                       np.flatnonzero(sf) if sf.dtype == bool else sf, colors, uv, face_uv,
-                      material_libs=mesh.material_libs, materials=mesh.materials, face_material=fm)
+                      material_libs=mesh.material_libs, materials=mesh.materials, face_material=fm,
+                      corner_sharpness=res.corner_sharpness)

@@ -32,17 +32,20 @@ class LevelResult:
     seconds: float
     uv: np.ndarray | None = None  # (t_L, e) refined face-varying data, with uv=
     face_uv: np.ndarray | None = None  # (m_L, 3) its index of each face corner
+    corner_sharpness: np.ndarray | None = None  # the sharpness left to each of corners (None: all infinite)
 
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
                     corners=None, loop_weights="loop", on_level=None, max_memory=None, uv=None, face_uv=None,
-                    uv_mode="linear", non_manifold="raise") -> LevelResult:
+                    uv_mode="linear", non_manifold="raise", corner_sharpness=None,
+                    boundary="edge_only") -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
     as in :func:`hybridsub.subdivide`. With ``uv (t, e)`` and ``face_uv (m, 3)`` the
     face-varying data is refined too (``uv_mode``), seams split as in
-    :func:`hybridsub.subdivide_face_varying`.
+    :func:`hybridsub.subdivide_face_varying`. ``corner_sharpness`` and ``boundary`` as in
+    :func:`hybridsub.subdivide` (``"none"``: the faces at the boundary are left out at the end).
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     F = F0 = np.asarray(F, dtype=np.int64)
@@ -52,7 +55,8 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     mask = None
     total = 0.0
     tags = dict(sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                max_memory=max_memory, non_manifold=non_manifold)
+                max_memory=max_memory, non_manifold=non_manifold, corner_sharpness=corner_sharpness,
+                boundary=boundary)
     if uv is not None:
         uv = np.ascontiguousarray(uv, dtype=np.float64)
         face_uv = np.asarray(face_uv, dtype=np.int64)
@@ -79,13 +83,20 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         pairs, sharp = np.empty((0, 2), np.int64), np.empty(0)
     if sharp is None:
         sharp = np.full(len(pairs), np.inf)
-    corners = np.empty(0, np.int64) if corners is None else np.asarray(corners, dtype=np.int64)
-    if non_manifold == "cut" and levels:  # the cut's copies are corners too (input vertices keep their numbers)
-        inp = open_gate(F0, sharp_edges, 0, n_vertices=n0, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
-                        corners=corners, loop_weights=loop_weights, non_manifold="cut")
-        corners = np.flatnonzero(inp.corner)
+    inp = open_gate(F0, sharp_edges, 0, n_vertices=n0, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
+                    corners=corners, loop_weights=loop_weights, non_manifold=non_manifold if levels else "raise",
+                    corner_sharpness=corner_sharpness, boundary=boundary)
+    # the cut's copies and edge_and_corner's vertices are corners too (input vertices keep their numbers);
+    # semi-sharp corners spent by the last level are corners no more
+    left = None if inp.corner_sharpness is None else inp.corner_sharpness - levels
+    corners = np.flatnonzero(inp.corner if left is None else left > 0)
+    left = None if left is None or not np.isfinite(left[corners]).any() else left[corners]
+    if inp.hole_faces is not None and levels:  # boundary="none": the faces at the boundary left out
+        keep = ~inp.hole_faces[parent]
+        F, mask, parent = F[keep], np.asarray(mask)[keep], parent[keep]
+        face_uv = None if face_uv is None else face_uv[keep]
     return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total, uv,
-                       face_uv)
+                       face_uv, left)
 
 
 class _StatusLine:

@@ -363,3 +363,47 @@ def as_uv_values(UV) -> np.ndarray:
         i = int(np.flatnonzero(~np.isfinite(A.reshape(len(A), -1)).all(axis=1))[0])
         raise MeshError(f"UV value {i} is not finite: {A[i].tolist()}")
     return A
+
+
+#: OpenSubdiv's Sdc::Options::VtxBoundaryInterpolation, by name (``docs/scheme.md``).
+BOUNDARY_MODES = ("edge_only", "edge_and_corner", "none")
+
+
+def check_boundary(boundary) -> str:
+    """The ``boundary=`` option, checked."""
+    if not isinstance(boundary, str) or boundary not in BOUNDARY_MODES:
+        raise ValueError(f"boundary must be one of {BOUNDARY_MODES}, got {boundary!r}")
+    return boundary
+
+
+def as_corner_sharpness(corners, corner_sharpness, n_vertices: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """``corners`` and their optional ``corner_sharpness``: the corner mask (n,) and, where
+    some corner is semi-sharp, the sharpness of every vertex (n,) float64 (``inf`` infinitely
+    sharp, ``0`` untagged; ≥ 10 is infinite), else None. A corner of sharpness 0 is no corner.
+
+    >>> mask, s = as_corner_sharpness([1, 2], [0.5, 20], 4)
+    >>> mask.tolist(), s.tolist()
+    ([False, True, True, False], [0.0, 0.5, inf, 0.0])
+    """
+    mask = as_corner_mask(corners, n_vertices)
+    if corner_sharpness is None:
+        return mask, None
+    if corners is None:
+        raise ValueError("corner_sharpness was given without corners")
+    S = np.asarray(corner_sharpness)
+    if S.dtype == bool or not (np.issubdtype(S.dtype, np.floating) or np.issubdtype(S.dtype, np.integer)):
+        raise TypeError(f"corner_sharpness must be real numbers (inf: infinitely sharp), got dtype {S.dtype}")
+    s = np.array(S, dtype=np.float64).reshape(-1)
+    A = np.asarray(corners)
+    idx = np.flatnonzero(A) if A.dtype == bool else np.asarray(A).reshape(-1).astype(np.int64)
+    if s.shape[0] != idx.shape[0]:
+        raise MeshError(f"corner_sharpness must have one value per corner ({idx.shape[0]}), got {s.shape[0]}")
+    bad = np.isnan(s) | (s < 0)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"corner_sharpness {j} (of corner vertex {int(idx[j])}) is {s[j]}; give a number >= 0 "
+                        "(0: no corner, >= 10 or inf: infinitely sharp)")
+    vs = np.zeros(n_vertices, np.float64)
+    np.maximum.at(vs, idx, R.normalize_sharpness(s))  # a vertex listed twice takes its sharpest value
+    mask = vs > 0
+    return mask, (vs if (np.isfinite(vs) & mask).any() else None)

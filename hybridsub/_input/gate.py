@@ -72,6 +72,12 @@ class RefineInput:
     uv: UVInput | None = None
     cut: Cut | None = None
     uncut: Uncut | None = None
+    # (n,) float64 sharpness of every vertex (inf: a corner, 0: none) where some corner is
+    # semi-sharp, else None (``corner`` then says it all); ``corner`` is ``corner_sharpness > 0``
+    corner_sharpness: np.ndarray | None = None
+    boundary: str = "edge_only"  # VtxBoundaryInterpolation; "edge_and_corner" is in ``corner`` already
+    # (m,) bool: input faces whose refined faces are left out of the output (``boundary="none"``), or None
+    hole_faces: np.ndarray | None = None
 
     @property
     def n_faces(self) -> int:
@@ -96,12 +102,13 @@ _SQRT3_UV = ('scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every
 def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
               sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise", max_memory=None,
               uv_faces=None, n_uvs=None, uv_mode="linear", uv_name="uv_faces", positions=None,
-              feature_angle=None) -> RefineInput:
+              feature_angle=None, corner_sharpness=None, boundary="edge_only") -> RefineInput:
     """Check one refinement's arguments (those of :func:`hybridsub.refine`) and describe it.
 
     ``positions`` ((n, 3) float64, already checked) and ``feature_angle`` add the features
     :func:`hybridsub.detect_features` finds to the tags; ``uv_name`` is the name errors give
-    the UV faces. Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
+    the UV faces. ``corner_sharpness`` gives the corners' sharpness (semi-sharp corners decay by
+    one a level); ``boundary`` is OpenSubdiv's boundary interpolation (``docs/scheme.md``). Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
     """
     levels = val.check_options(scheme, levels, loop_weights)
     if uv_faces is None and n_uvs is not None:
@@ -118,7 +125,8 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
         uv = UVInput(T, n_uvs if n_uvs is not None else (int(T.max()) + 1 if T.size else 0), uv_mode)
     pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
     face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
-    corner = val.as_corner_mask(corners, n)
+    corner, vsharp = val.as_corner_sharpness(corners, corner_sharpness, n)
+    boundary = val.check_boundary(boundary)
     level = None
     if feature_angle is not None:  # on the input's level, which then serves the refinement too
         angle = check_angle("feature_angle", feature_angle)
@@ -128,29 +136,58 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
             level = checked_level(Fi, n, pairs)
             feat = features_of_level(positions, level, angle)
         pairs, sharp, corner = merge_detected(feat, pairs, sharp, corner, n)
+        if vsharp is not None:  # detected corners are infinitely sharp
+            vsharp = np.where(corner & (vsharp == 0), np.inf, vsharp)
     if scheme == "sqrt3" and (len(pairs) or face_sharp.any() or corner.any()):
         raise ValueError(_SQRT3_TAGS)
     if scheme == "loop":
         face_sharp[:] = True
     common = dict(levels=levels, scheme=scheme, loop_weights=loop_weights, face_sharp=face_sharp,
-                  faces_as_indices=faces_as_indices, max_memory=max_memory)
+                  faces_as_indices=faces_as_indices, max_memory=max_memory, boundary=boundary)
     cut = _cut(Fi, n, pairs, sharp) if cut_asked else None
     if cut is None:
         keep = sharp > 0
         if level is None:
             level = checked_level(Fi, n, pairs)
         level = level.tag(pairs[keep], sharp[keep], face_sharp)
+        corner, vsharp, holes = _boundary_tags(level, boundary, corner, vsharp)
         return RefineInput(Fi, n, sharp_edges=pairs[keep], sharpness=sharp[keep], corner=corner, level=level,
-                           uv=_with_uv_level(uv, level, corner), **common)
+                           uv=_with_uv_level(uv, level, corner), corner_sharpness=vsharp, hole_faces=holes, **common)
     cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)
     ccorner = corner[cut.origin]
     if scheme != "sqrt3":  # sqrt3 takes no tags: its pieces follow Kobbelt's boundary rule
         ccorner = ccorner | cut.corner
     keep, kept = csharp > 0, sharp > 0
     level = checked_level(cut.faces, cut.n_vertices, cpairs).tag(cpairs[keep], csharp[keep], face_sharp)
+    cvsharp = None if vsharp is None else np.where(ccorner & (vsharp[cut.origin] == 0), np.inf, vsharp[cut.origin])
+    ccorner, cvsharp, holes = _boundary_tags(level, boundary, ccorner, cvsharp)
     return RefineInput(cut.faces, cut.n_vertices, sharp_edges=cpairs[keep], sharpness=csharp[keep],
                        corner=ccorner, level=level, uv=_with_uv_level(uv, level, ccorner), cut=cut,
-                       uncut=Uncut(Fi, n, pairs[kept], sharp[kept], corner), **common)
+                       uncut=Uncut(Fi, n, pairs[kept], sharp[kept], corner), corner_sharpness=cvsharp,
+                       hole_faces=holes, **common)
+
+
+def _boundary_tags(level: Level, boundary: str, corner: np.ndarray, vsharp: np.ndarray | None):
+    """OpenSubdiv's boundary interpolation on level 0: (corner, corner sharpness, hole faces).
+
+    ``"edge_and_corner"``: a boundary vertex in one face only becomes an infinitely sharp
+    corner; ``"none"``: the refinement is ``"edge_only"``'s, and the faces with a vertex on
+    the boundary are holes (left out of the output faces, as OpenSubdiv tags them).
+    """
+    if boundary == "edge_only" or level.n_faces == 0:
+        return corner, vsharp, None
+    on_boundary = np.zeros(level.n_vertices, dtype=bool)
+    open_h = np.flatnonzero(level.twin < 0)
+    on_boundary[level.faces.reshape(-1)[open_h]] = True
+    if boundary == "none":
+        return corner, vsharp, on_boundary[level.faces].any(axis=1)
+    lone = on_boundary & (np.bincount(level.faces.reshape(-1), minlength=level.n_vertices) == 1)
+    if not lone.any():
+        return corner, vsharp, None
+    corner = corner | lone
+    if vsharp is not None:
+        vsharp = np.where(lone, np.inf, vsharp)
+    return corner, vsharp, None
 
 
 def _with_uv_level(uv: UVInput | None, level: Level, corner: np.ndarray) -> UVInput | None:

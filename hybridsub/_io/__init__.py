@@ -15,11 +15,11 @@ examples.py       the shipped example meshes (example_path, load_example)
 from .examples import example_path, load_example
 from .formats import check_writable, read_mesh, write, write_mesh
 from .convert import TAG_NAMES, kind_of, triangles_of
-from .mesh import METADATA_KEY, TaggedMesh, describe_tags
+from .mesh import METADATA_KEY, TaggedMesh, corner_tags, describe_tags
 from .off import read_off
 from .tagfiles import read_edge_file, read_list_file
 from .weld import classes, weld
 
-__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "check_writable", "classes", "kind_of", "triangles_of",
+__all__ = ["METADATA_KEY", "TAG_NAMES", "TaggedMesh", "check_writable", "classes", "corner_tags", "kind_of", "triangles_of",
            "describe_tags", "example_path", "load_example", "read_edge_file",
            "read_list_file", "read_mesh", "read_off", "weld", "write", "write_mesh"]

@@ -12,7 +12,7 @@ from .._errors import MeshError
 from .mesh import METADATA_KEY, TaggedMesh, as_tagged
 
 #: The tag names both conventions use (``TaggedMesh.tag_arrays``).
-TAG_NAMES = ("sharp_edges", "sharpness", "corners", "sharp_faces")
+TAG_NAMES = ("sharp_edges", "sharpness", "corners", "sharp_faces", "corner_sharpness")
 
 
 def kind_of(obj: Any) -> str | None:

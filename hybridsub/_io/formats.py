@@ -111,7 +111,8 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
                sharp_edges: ArrayLike | None = None, sharpness: ArrayLike | None = None,
                corners: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                vertex_colors: ArrayLike | None = None, uv: ArrayLike | None = None,
-               face_uv: ArrayLike | None = None, binary: bool = True) -> None:
+               face_uv: ArrayLike | None = None, binary: bool = True,
+               corner_sharpness: ArrayLike | None = None) -> None:
     """Write a triangle mesh with its feature tags: arrays, or a mesh object in one line.
 
     OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
@@ -140,6 +141,9 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
         Default ``inf``; written as 10 (OpenSubdiv's infinitely sharp).
     corners, sharp_faces : array_like of int, optional
         Vertex indices, face indices (boolean masks are accepted too).
+    corner_sharpness : (c,) array_like of float, optional
+        Sharpness of each of ``corners`` (default ``inf``, written as 10): OBJ's ``t corner``
+        value, PLY's ``corner`` comment, NPZ's ``corner_sharpness``, meshio's cell data.
     vertex_colors : (n, 3 or 4) array_like, optional
         Floats in [0, 1] or integers in 0..255.
     uv : (n, 2) or (t, 2) array_like of float, optional
@@ -162,7 +166,8 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
     >>> len(hybridsub.read_mesh(path).sharp_edges)
     1444
     """
-    mesh = _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv)
+    mesh = _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
+                    corner_sharpness)
     dropped = write(os.fspath(path), mesh, binary=binary)
     if dropped:
         warnings.warn(f"{os.fspath(path)}: this format cannot hold {dropped}; write .obj or .ply to keep them",
@@ -170,29 +175,34 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
 
 
 
-def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv) -> TaggedMesh:
+def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
+             corner_sharpness=None) -> TaggedMesh:
     """write_mesh's arguments as a TaggedMesh: arrays, or a mesh object and optional tags."""
     kind = "tagged" if isinstance(vertices, TaggedMesh) else kind_of(vertices)
     if kind is None:
         if faces is None:
             raise TypeError("write_mesh(path, vertices, faces, ...) needs faces, or write_mesh(path, mesh) a "
                             f"trimesh.Trimesh, pyvista.PolyData or hybridsub.TaggedMesh; got {type(vertices).__name__}")
-        return as_tagged(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv)
+        return as_tagged(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
+                         corner_sharpness)
     if faces is not None:
         raise TypeError(f"write_mesh(path, mesh) takes no faces: the {type(vertices).__name__} has its own")
     if vertex_colors is not None or uv is not None or face_uv is not None:
         raise TypeError("write_mesh(path, mesh): colours and UVs come from the mesh; pass arrays to set them")
     m = vertices if kind == "tagged" else from_trimesh(vertices) if kind == "trimesh" else from_pyvista(vertices)
-    if sharp_edges is None and sharpness is None and corners is None and sharp_faces is None:
+    if sharp_edges is None and sharpness is None and corners is None and sharp_faces is None \
+            and corner_sharpness is None:
         return m
     tags = m.tag_arrays()
     if sharp_edges is not None or sharpness is not None:
         tags["sharp_edges"], tags["sharpness"] = sharp_edges, sharpness
-    tags["corners"] = tags["corners"] if corners is None else corners
+    if corners is not None or corner_sharpness is not None:
+        tags["corners"] = tags["corners"] if corners is None else corners
+        tags["corner_sharpness"] = corner_sharpness
     tags["sharp_faces"] = tags["sharp_faces"] if sharp_faces is None else sharp_faces
     checked = as_tagged(m.vertices, m.faces, **tags)
     return replace(m, sharp_edges=checked.sharp_edges, sharpness=checked.sharpness, corners=checked.corners,
-                   sharp_faces=checked.sharp_faces)
+                   sharp_faces=checked.sharp_faces, corner_sharpness=checked.corner_sharpness)
 
 
 def check_writable(path: str, *, binary: bool = True) -> None:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import MeshError
-from .._input import as_corner_mask, as_face_mask, as_faces, as_sharp_edges, as_vertices, count_of, tag_counts
+from .._input import as_corner_mask, as_corner_sharpness, as_face_mask, as_faces, as_sharp_edges, as_vertices, count_of, tag_counts
 from .._rules import INFINITE_SHARPNESS
 
 #: Key of ``Trimesh.metadata`` under which hybridsub keeps a mesh's tags (``subdivide_mesh``'s
@@ -79,6 +79,7 @@ class TaggedMesh:
     material_libs: tuple = ()
     materials: tuple = ()
     face_material: np.ndarray | None = None
+    corner_sharpness: np.ndarray | None = None  # (c,) float64 beside corners (inf: infinite), None: all infinite
 
     @property
     def vertex_uv(self) -> np.ndarray | None:
@@ -112,9 +113,12 @@ class TaggedMesh:
         """The tags as arrays by name: ``sharp_edges`` (k, 2), ``sharpness`` (k,) (``inf``:
         infinitely sharp), ``corners``, ``sharp_faces`` — what :meth:`to_trimesh` stores in
         ``metadata["hybridsub"]`` and :meth:`to_pyvista` in ``field_data``."""
-        return {"sharp_edges": np.asarray(self.sharp_edges, np.int64).reshape(-1, 2),
-                "sharpness": np.asarray(self.sharpness, np.float64),
-                "corners": np.asarray(self.corners, np.int64), "sharp_faces": np.asarray(self.sharp_faces, np.int64)}
+        out = {"sharp_edges": np.asarray(self.sharp_edges, np.int64).reshape(-1, 2),
+               "sharpness": np.asarray(self.sharpness, np.float64),
+               "corners": np.asarray(self.corners, np.int64), "sharp_faces": np.asarray(self.sharp_faces, np.int64)}
+        if self.corner_sharpness is not None:  # semi-sharp corners: their sharpness beside them
+            out["corner_sharpness"] = np.asarray(self.corner_sharpness, np.float64)
+        return out
 
     def to_trimesh(self):
         """This mesh as a ``trimesh.Trimesh`` (``process=False``), its tags in
@@ -306,6 +310,34 @@ def sharpness_from_file(s: np.ndarray) -> np.ndarray:
     return np.where(s >= INFINITE, np.inf, s)
 
 
+def corner_tags(C, s) -> tuple[np.ndarray, np.ndarray | None]:
+    """Corner tags read from a file, vertex ``C[j]`` of sharpness ``s[j]`` (``>= 10``:
+    infinite): the sorted corners of sharpness > 0 (a vertex listed twice takes its sharpest
+    value) and their sharpness, or None where every one is infinitely sharp.
+
+    >>> C, s = corner_tags(np.array([4, 2, 3]), np.array([10.0, 0.5, 0.0]))
+    >>> C.tolist(), s.tolist()
+    ([2, 4], [0.5, inf])
+    """
+    C = np.asarray(C, np.int64).reshape(-1)
+    s = sharpness_from_file(np.asarray(s, np.float64).reshape(-1))
+    keep = s > 0
+    C, s = C[keep], s[keep]
+    order = np.lexsort((-s, C))
+    C, s = C[order], s[order]
+    first = np.ones(len(C), bool)
+    first[1:] = C[1:] != C[:-1]
+    C, s = C[first], s[first]
+    return C, (s if np.isfinite(s).any() else None)
+
+
+def corner_values(m: TaggedMesh) -> np.ndarray:
+    """The sharpness of each of ``m.corners`` as written to a file (10: infinitely sharp)."""
+    if m.corner_sharpness is None:
+        return np.full(len(m.corners), INFINITE)
+    return sharpness_to_file(np.asarray(m.corner_sharpness, np.float64))
+
+
 def sharpness_to_file(s: np.ndarray) -> np.ndarray:
     """Sharpness as written to a file: ``inf`` becomes 10.
 
@@ -334,7 +366,7 @@ def color_bytes(colors: np.ndarray) -> np.ndarray:
 
 
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
-              vertex_colors=None, uv=None, face_uv=None) -> TaggedMesh:
+              vertex_colors=None, uv=None, face_uv=None, corner_sharpness=None) -> TaggedMesh:
     """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays; creases of
     sharpness 0 left out, masks turned into indices, integer colours scaled to [0, 1]).
 
@@ -347,7 +379,9 @@ def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, s
     E, s = as_sharp_edges(sharp_edges, sharpness, len(V))
     keep = s > 0
     E, s = E[keep], s[keep]
-    C = np.flatnonzero(as_corner_mask(corners, len(V)))
+    mask, vs = as_corner_sharpness(corners, corner_sharpness, len(V))
+    C = np.flatnonzero(mask)
+    Cs = None if vs is None else vs[C]
     S = np.flatnonzero(as_face_mask(sharp_faces, len(F))[0])
     colors = None
     if vertex_colors is not None:
@@ -370,7 +404,7 @@ def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, s
                 raise MeshError(f"face_uv must have the shape of faces {F.shape}, got {FT.shape}")
             if FT.size and (FT.min() < 0 or FT.max() >= len(T)):
                 raise MeshError(f"face_uv holds an index outside 0..{len(T) - 1}")
-    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT)
+    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT, corner_sharpness=Cs)
 
 
 def describe_tags(mesh: TaggedMesh) -> str:

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._errors import MeshError
 from .._input import count_of
-from .mesh import INFINITE, TaggedMesh, color_bytes, describe_tags, sharpness_from_file, sharpness_to_file
+from .mesh import INFINITE, TaggedMesh, color_bytes, corner_tags, corner_values, describe_tags, sharpness_from_file, sharpness_to_file
 from .tables import triangulate_polygons
 
 _SURFACE = {"triangle", "quad", "polygon"}
@@ -46,7 +46,7 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     if P.ndim != 2 or P.shape[1] not in (2, 3):
         raise MeshError(f"{path}: points of shape {P.shape}; a surface mesh needs 2 or 3 coordinates")
     V = np.pad(P, ((0, 0), (0, 3 - P.shape[1])))
-    polys, sharp_face, pairs, psharp, corners, notes = [], [], [], [], [], []
+    polys, sharp_face, pairs, psharp, corners, csharp, notes = [], [], [], [], [], [], []
     _check_cells(path, mesh, len(V))
     for i, block in enumerate(mesh.cells):
         try:
@@ -65,7 +65,8 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
             pairs.append(np.asarray(block.data, np.int64))
             psharp.append(data["sharpness"][:, 0].astype(np.float64))
         elif block.type == "vertex" and "sharpness" in data:
-            corners.append(np.asarray(block.data, np.int64)[data["sharpness"][:, 0] > 0, 0])
+            corners.append(np.asarray(block.data, np.int64)[:, 0])
+            csharp.append(data["sharpness"][:, 0])
         else:
             notes.append(f"skipped {len(block.data)} {block.type} cells")
     F, origin = triangulate_polygons(path, polys, triangulate)
@@ -77,7 +78,7 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
         j = int(np.flatnonzero(np.isnan(s))[0])
         raise MeshError(f"{path}: crease (line cell) {j} has sharpness nan")
     E, s = E[s > 0], sharpness_from_file(s[s > 0])
-    C = np.unique(np.concatenate(corners)) if corners else np.empty(0, np.int64)
+    C, Cs = corner_tags(np.concatenate(corners), np.concatenate(csharp)) if corners else (np.empty(0, np.int64), None)
     colors = uv = face_uv = None
     pd = mesh.point_data
     if "colors" in pd:
@@ -93,7 +94,7 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     if origin is not None:
         notes.append(f"triangulated {len(polys)} polygons into {len(F)} triangles")
     notes += said
-    return TaggedMesh(V, F, E, s, C, sf.astype(np.int64), colors, uv, face_uv, tuple(notes))
+    return TaggedMesh(V, F, E, s, C, sf.astype(np.int64), colors, uv, face_uv, tuple(notes), corner_sharpness=Cs)
 
 
 def _meshio_read(path: str):
@@ -196,7 +197,7 @@ def write_meshio(path: str, m: TaggedMesh) -> str:
             marks.append(np.zeros(len(m.sharp_edges), np.uint8))
         if len(m.corners):
             cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
-            sharp.append(np.full(len(m.corners), INFINITE))
+            sharp.append(corner_values(m))
             marks.append(np.zeros(len(m.corners), np.uint8))
         tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
                              cell_data={"sharpness": sharp, "sharp_face": marks})

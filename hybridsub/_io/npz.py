@@ -13,7 +13,7 @@ from .mesh import TaggedMesh, as_tagged
 
 #: The arrays of an NPZ mesh file, in the order written (docs/formats.md).
 NPZ_ARRAYS = ("vertices", "faces", "sharp_edges", "sharpness", "corners", "sharp_faces", "vertex_colors", "uv",
-              "face_uv")
+              "face_uv", "corner_sharpness")
 
 
 def read_npz(path: str) -> TaggedMesh:

@@ -19,7 +19,7 @@ from .._errors import MeshError
 from .._input import count_of
 from .._topology import group_halfedges, halfedge_ends
 from .._version import __version__
-from .mesh import INFINITE, TaggedMesh, describe_tags, sharpness_from_file, sharpness_to_file, unit_colors
+from .mesh import INFINITE, TaggedMesh, corner_tags, corner_values, describe_tags, sharpness_from_file, sharpness_to_file, unit_colors
 from .tables import MAX_INDEX, check_faces, check_indices, text_rows, triangulate_polygons
 
 
@@ -217,13 +217,18 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
     check_faces(path, F, len(V), origin, base=1)
     if face_uv is not None and uv is not None:
         check_indices(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}", base=1)
-    edges, sharpness, corners, sharp_faces, tag_notes, boundary_corners = _parse_tags(path, extras.tags, len(V),
-                                                                                      len(faces))
+    edges, sharpness, (corners, corner_s), sharp_faces, tag_notes, boundary_corners = _parse_tags(
+        path, extras.tags, len(V), len(faces))
     if origin is not None and len(sharp_faces):
         sharp_faces = np.flatnonzero(np.isin(origin, sharp_faces))
     if boundary_corners:  # OpenSubdiv's VTX_BOUNDARY_EDGE_AND_CORNER
         extra = np.setdiff1d(boundary_corner_vertices(F), corners)
+        if corner_s is not None:  # all of them infinitely sharp (OpenSubdiv's SharpenBoundaryVertex)
+            corner_s = np.concatenate([corner_s, np.full(len(extra), np.inf)])[np.argsort(np.r_[corners, extra])]
         corners = np.union1d(corners, extra)
+        if corner_s is not None:
+            corner_s[np.isin(corners, boundary_corner_vertices(F))] = np.inf
+            corner_s = corner_s if np.isfinite(corner_s).any() else None
         if len(extra):
             tag_notes.append(f"'interpolateboundary 2': {len(extra)} boundary vertices in a single face "
                              "made corners")
@@ -231,7 +236,7 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
     if face_material is not None and origin is not None:
         face_material = face_material[origin]
     return TaggedMesh(V, F, edges, sharpness, corners, sharp_faces, colors, uv, face_uv,
-                      tuple(notes + tag_notes), tuple(extras.libs), tuple(extras.names), face_material)
+                      tuple(notes + tag_notes), tuple(extras.libs), tuple(extras.names), face_material, corner_s)
 
 
 def _obj_vertices(path, rows):
@@ -332,12 +337,12 @@ def _parse_tags(path, tags, n_vertices, n_faces):
     if unknown:
         notes.append("ignored tags: " + ", ".join(sorted(unknown)))
     E, s = _tag_creases(path, edges, edge_s, n_vertices, notes)
-    C = _tag_corners(path, corners, corner_s, n_vertices, notes)
+    C, Cs = _tag_corners(path, corners, corner_s, n_vertices)
     S = np.array(faces, dtype=np.int64)
     bad = (S < 0) | (S >= n_faces)
     if bad.any():
         raise MeshError(f"{path}: sharpface tag names face {int(S[bad][0])}, but the file has {n_faces} faces")
-    return E, s, C, np.unique(S), notes, boundary_corners
+    return E, s, (C, Cs), np.unique(S), notes, boundary_corners
 
 
 def _tag_creases(path, edges, edge_s, n_vertices, notes):
@@ -355,19 +360,16 @@ def _tag_creases(path, edges, edge_s, n_vertices, notes):
     return E[keep], sharpness_from_file(s[keep])
 
 
-def _tag_corners(path, corners, corner_s, n_vertices, notes):
-    """Corner tags as sorted vertices; those of sharpness <= 0 are left out, the rest infinitely sharp."""
+def _tag_corners(path, corners, corner_s, n_vertices):
+    """Corner tags as sorted vertices and their sharpness (None: all infinite); those of
+    sharpness <= 0 are left out (:func:`corner_tags`)."""
     C = np.array(corners, dtype=np.int64)
     cs = np.array(corner_s, dtype=np.float64)
     bad = (C < 0) | (C >= n_vertices)
     if bad.any():
         raise MeshError(f"{path}: corner tag names vertex {int(C[bad][0])}, but the file has {n_vertices} "
                         f"vertices (0..{n_vertices - 1})")
-    semi = (cs > 0) & (cs < INFINITE)
-    if semi.any():
-        notes.append(f"{int(semi.sum())} corner tags with finite sharpness treated as infinitely sharp "
-                     "(hybridsub has no semi-sharp corners)")
-    return np.unique(C[cs > 0])
+    return corner_tags(C, cs)
 
 
 def boundary_corner_vertices(F: np.ndarray) -> np.ndarray:
@@ -436,7 +438,8 @@ def _tag_lines(m: TaggedMesh) -> list[str]:
         E = m.sharp_edges.tolist()
         parts.append("".join(f"t crease 2/1/0 {a} {b} {float(x)!r}\n" for (a, b), x in zip(E, s.tolist())))
     if len(m.corners):
-        parts.append("".join(f"t corner 1/1/0 {v} {INFINITE!r}\n" for v in m.corners.tolist()))
+        parts.append("".join(f"t corner 1/1/0 {v} {float(x)!r}\n"
+                             for v, x in zip(m.corners.tolist(), corner_values(m).tolist())))
     S = m.sharp_faces.tolist()
     for i in range(0, len(S), 16):  # OpenSubdiv's reader takes lines of at most 255 characters
         chunk = S[i:i + 16]

@@ -22,7 +22,7 @@ import numpy as np
 from .._errors import MeshError
 from .._input import count_of
 from .._version import __version__
-from .mesh import INFINITE, TaggedMesh, color_bytes, sharpness_from_file, sharpness_to_file
+from .mesh import INFINITE, TaggedMesh, color_bytes, corner_tags, corner_values, sharpness_from_file, sharpness_to_file
 from .tables import check_faces, triangulate_polygons
 
 _TYPES = {
@@ -357,10 +357,10 @@ def read_ply_mesh(path: str, triangulate: bool) -> TaggedMesh:
     notes = [f"triangulated {count_of(len(polys), 'polygon')} into {count_of(len(F), 'triangle')}"] if origin is not None else []
     tags = _comment_tags(path, comments)
     E, s = _ply_creases(path, el, tags, n)
-    C = _ply_corners(path, el, tags, n)
+    C, Cs = _ply_corners(path, el, tags, n)
     S = _ply_sharp_faces(path, el, tags, len(polys), origin)
     return TaggedMesh(np.ascontiguousarray(V), np.ascontiguousarray(F), E, s, C, S, colors, uv, face_uv,
-                      tuple(notes))
+                      tuple(notes), corner_sharpness=Cs)
 
 
 def _ply_vertices(path: str, el: dict[str, dict]) -> tuple[np.ndarray, np.ndarray | None]:
@@ -459,20 +459,25 @@ def _ply_creases(path: str, el: dict[str, dict], tags: dict, n: int) -> tuple[np
     return E[keep], sharpness_from_file(s[keep])
 
 
-def _ply_corners(path: str, el: dict[str, dict], tags: dict, n: int) -> np.ndarray:
-    """Sorted corner vertices of the ``corner`` comments and element (sharpness <= 0 left out)."""
-    found = []
+def _ply_corners(path: str, el: dict[str, dict], tags: dict, n: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """Sorted corner vertices of the ``corner`` comments and element (sharpness <= 0 left out)
+    and their sharpness (None: all infinite, :func:`corner_tags`)."""
+    found, values = [], []
     if "corner" in tags:
         c = tags["corner"]
-        found.append(_vertex_ids(path, "corner", c[:, :1], n)[c[:, 1] > 0, 0])
+        found.append(_vertex_ids(path, "corner", c[:, :1], n)[:, 0])
+        values.append(c[:, 1])
     if "corner" in el:
         cd = el["corner"]
         ck = next((k for k in ("vertex", "vertex_index") if k in cd), None)
         if ck is None:
             raise MeshError(f"{path}: the PLY 'corner' element needs a 'vertex' property")
         C = _vertex_ids(path, "corner", np.asarray(cd[ck], dtype=np.float64)[:, None], n)[:, 0]
-        found.append(C[np.asarray(cd["sharpness"]) > 0] if "sharpness" in cd else C)
-    return np.unique(np.concatenate(found)) if found else np.empty(0, np.int64)
+        found.append(C)
+        values.append(np.asarray(cd["sharpness"], np.float64) if "sharpness" in cd else np.full(len(C), np.inf))
+    if not found:
+        return np.empty(0, np.int64), None
+    return corner_tags(np.concatenate(found), np.concatenate(values))
 
 
 def _ply_sharp_faces(path: str, el: dict[str, dict], tags: dict, nf: int, origin: np.ndarray | None) -> np.ndarray:
@@ -520,7 +525,7 @@ def write_ply_mesh(path: str, m: TaggedMesh, binary: bool) -> None:
         comments.append("tags: crease vertex1 vertex2 sharpness (0-based, 10 = infinitely sharp); "
                         "corner vertex sharpness; sharp_face face")
     comments += _tag_lines("crease", [m.sharp_edges[:, 0], m.sharp_edges[:, 1], sharpness_to_file(m.sharpness)])
-    comments += _tag_lines("corner", [np.asarray(m.corners), np.full(len(m.corners), INFINITE)])
+    comments += _tag_lines("corner", [np.asarray(m.corners), corner_values(m)])
     comments += _tag_lines("sharp_face", [np.asarray(m.sharp_faces)])
     write_ply(path, [("vertex", vertex), ("face", face)], binary=binary, comments=tuple(comments))
 

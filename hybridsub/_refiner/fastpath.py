@@ -21,11 +21,11 @@ import scipy.sparse as sp
 
 from .._input import RefineInput, as_vertices, open_gate
 from .._topology import child_creases, face_parents
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme
 from .budget import Budget
 from .linear_uv import linear_uv_apply
 from .loop import walk
-from .refinement import refinement_of
+from .refinement import refinement_of, without_holes
 from .stencils import apply_step
 
 
@@ -38,7 +38,8 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[False] = ...,
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ..., corner_sharpness: ArrayLike | None = ...,
+              boundary: Boundary = ...) -> tuple[Positions, Faces]: ...
 
 
 @overload
@@ -46,7 +47,8 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[True],
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ..., corner_sharpness: ArrayLike | None = ...,
+              boundary: Boundary = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
 def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
@@ -54,6 +56,7 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
               max_memory: MemoryLimit = None, progress: bool | None = False,
+              corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
               ) -> tuple[Positions, Faces] | tuple[Positions, Faces, sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
@@ -78,6 +81,11 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
         Faces split 1-to-4 by Loop's rule.
     corners : array_like of int, optional
         Vertices that never move (vertices with three or more creases are corners anyway).
+    corner_sharpness : (c,) array_like of float, optional
+        Sharpness of each of ``corners`` (default ``inf``): semi-sharp corners, as
+        :func:`refine` (OpenSubdiv's vertex sharpness).
+    boundary : {"edge_only", "edge_and_corner", "none"}
+        OpenSubdiv's boundary interpolation; see :func:`refine` and ``docs/scheme.md``.
     loop_weights : {"loop", "warren"}
         Smooth vertex weights in Loop regions.
     return_matrix : bool
@@ -124,9 +132,10 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
         raise TypeError("subdivide(V, F, ...) needs the faces F (an (m, 3) array of vertex indices)")
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
-                    max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
-    if return_matrix or inp.cut is not None:  # a cut mesh's positions come through S_1 @ D
-        r = refinement_of(inp, progress)
+                    max_memory=max_memory, positions=Vf, feature_angle=feature_angle,
+                    corner_sharpness=corner_sharpness, boundary=boundary)
+    if return_matrix or inp.cut is not None or inp.hole_faces is not None:  # a cut mesh's through S_1 @ D
+        r = without_holes(inp, refinement_of(inp, progress))
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
     X, faces = _last_level(inp, Vf, progress)
@@ -195,24 +204,27 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
                      corners=None, loop_weights="loop", tags=True, max_memory=None,
-                     non_manifold="raise") -> Iterator[LevelOutput]:
+                     non_manifold="raise", corner_sharpness=None, boundary="edge_only") -> Iterator[LevelOutput]:
     """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
     (the command line's progress bar) or the propagated tags with the positions. ``X`` is
     any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
     tags nor face parents are computed (nor the last level's twins). ``max_memory`` and
-    ``non_manifold`` as in :func:`subdivide` (with ``"cut"`` the levels are those of the cut mesh).
+    ``non_manifold`` as in :func:`subdivide` (with ``"cut"`` the levels are those of the cut mesh);
+    ``corner_sharpness`` and ``boundary`` too, except that ``boundary="none"`` keeps every face
+    here (the command line drops the holes from the last level by their input faces).
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    non_manifold=non_manifold)
+                    non_manifold=non_manifold, corner_sharpness=corner_sharpness, boundary=boundary)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], tags=tags)
 
 
 def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_edges=None, levels: int = 1, *,
                                   scheme="hybrid", uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
-                                  loop_weights="loop", max_memory=None, non_manifold="raise") -> Iterator[LevelOutput]:
+                                  loop_weights="loop", max_memory=None, non_manifold="raise", corner_sharpness=None,
+                                  boundary="edge_only") -> Iterator[LevelOutput]:
     """The face-varying fast path: yield a :class:`LevelOutput` (with ``UV`` and ``uv_faces``)
     per step, no matrix kept.
 
@@ -222,5 +234,6 @@ def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_e
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold)
+                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold,
+                    corner_sharpness=corner_sharpness, boundary=boundary)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], UV)

@@ -76,7 +76,8 @@ def walk(inp: RefineInput, budget: Budget | None = None, topology_last: bool = T
 
 def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool,
            data_first: DataFirst | None) -> Iterator[Step]:
-    level, corner = inp.level, inp.corner
+    level = inp.level
+    corner = inp.corner if inp.corner_sharpness is None else inp.corner_sharpness  # semi-sharp: decays
     uvl = uv_fixed = None
     if inp.uv is not None:
         uvl, uv_fixed = inp.uv.level, inp.uv.corner
@@ -107,6 +108,18 @@ def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool,
             uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
             uvl = uv_child
         yield Step(step, level, plan, faces, child, offsets, uv)
-        corner = np.concatenate([corner, np.zeros(plan.n_new - len(corner), dtype=bool)])
+        corner = next_corners(corner, plan.n_new)
         level = child
         del plan, uv_plan, faces, child, offsets, uv  # not held while the next step is planned
+
+
+def next_corners(corner: np.ndarray, n_next: int) -> np.ndarray:
+    """The corners of the next level (``n_next`` vertices): a mask carried as it is, or vertex
+    sharpness (float64) decayed by one (``inf`` stays; new points are never corners).
+
+    >>> next_corners(np.array([0.5, 2.5, np.inf]), 4).tolist()
+    [0.0, 1.5, inf, 0.0]
+    """
+    if corner.dtype == np.float64:
+        return np.concatenate([R.child_sharpness(corner), np.zeros(n_next - len(corner))])
+    return np.concatenate([corner, np.zeros(n_next - len(corner), dtype=bool)])

@@ -17,7 +17,7 @@ from .._input import RefineInput, as_data, count_of, open_gate, tag_counts, writ
 from .._topology import build_level, child_creases, face_parents
 from typing import TYPE_CHECKING
 
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .budget import Budget, check_product
 from .chart import vertex_origins
 from .loop import Step, walk
@@ -110,6 +110,10 @@ class Refinement:
     face_level, vertex_level : (m_L,) and (n_L,) int64 or None
         From :func:`hybridsub.refine_adaptive`: the level of each output face and vertex (each
         vertex sits where the uniform refinement of its level puts it); None from ``refine``.
+    corner_sharpness : (c,) float64 or None
+        With semi-sharp corners (``corner_sharpness=``): the sharpness each of ``corners`` has
+        left at the finest level (each level takes one off; ``corners`` lists those still
+        sharp); None when every corner is infinitely sharp.
     """
 
     faces: np.ndarray
@@ -126,6 +130,7 @@ class Refinement:
     face_level: np.ndarray | None = field(default=None, repr=False)  # adaptive refinement: each face's level
     vertex_level: np.ndarray | None = field(default=None, repr=False)  # and each vertex's
     _cache: dict = field(default_factory=dict, repr=False)
+    corner_sharpness: np.ndarray | None = field(default=None, repr=False)  # semi-sharp corners' sharpness left
 
     @property
     def n_vertices(self) -> int:
@@ -323,7 +328,8 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
            scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
            corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
            non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
-           n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False) -> Refinement:
+           n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False,
+           corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -345,6 +351,16 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
         Faces refined by Loop's 1-to-4 split (``"hybrid"``).
     corners : array_like of int, optional
         Vertices that never move.
+    corner_sharpness : (c,) array_like of float, optional
+        Sharpness of each of ``corners`` (default ``inf``): a corner of sharpness s stays a
+        corner for ⌊s⌋ levels and blends into its smooth or crease rule at the level where
+        it decays (OpenSubdiv's vertex sharpness); ``>= 10`` is infinite, ``0`` no corner.
+    boundary : {"edge_only", "edge_and_corner", "none"}
+        OpenSubdiv's boundary interpolation: ``"edge_only"`` (default) the boundary is a
+        crease; ``"edge_and_corner"`` also makes each boundary vertex in only one face a
+        corner; ``"none"`` refines as ``"edge_only"`` but leaves the faces descending from
+        input faces with a vertex on the boundary out of ``faces`` (OpenSubdiv's holes; the
+        vertices and matrices keep them). See ``docs/scheme.md``.
     loop_weights : {"loop", "warren"}
         Smooth vertex weights in Loop regions.
     non_manifold : {"raise", "cut"}
@@ -399,8 +415,37 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
-                    max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode)
-    return refinement_of(inp, progress)
+                    max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode,
+                    corner_sharpness=corner_sharpness, boundary=boundary)
+    return without_holes(inp, refinement_of(inp, progress))
+
+
+def without_holes(inp: RefineInput, r: Refinement) -> Refinement:
+    """``r`` with the faces that descend from ``inp.hole_faces`` left out of its finest level
+    (``faces``, ``face_parent``, ``sharp_faces``, ``uv_faces``); vertices, steps and matrices
+    keep them (``boundary="none"``)."""
+    if inp.hole_faces is None or not inp.hole_faces.any():
+        return r
+    keep = ~inp.hole_faces[r.face_parent]
+    sf = np.asarray(r.sharp_faces)
+    if sf.dtype == bool:
+        sf = sf[keep]
+    else:
+        sf = np.flatnonzero(np.isin(np.arange(len(keep)), sf)[keep])
+    uv = r.uv_refinement
+    if uv is not None:
+        uv = dataclasses.replace(uv, faces=uv.faces[keep], face_parent=uv.face_parent[keep], sharp_faces=sf, _cache={})
+    return dataclasses.replace(r, faces=r.faces[keep], face_parent=r.face_parent[keep], sharp_faces=sf,
+                               uv_refinement=uv, _cache={})
+
+
+def _level_corners(inp: RefineInput, k: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """The corners still sharp at level ``k`` and, with semi-sharp ones, their sharpness left."""
+    if inp.corner_sharpness is None:
+        return np.flatnonzero(inp.corner), None
+    left = inp.corner_sharpness - k  # inf stays inf
+    c = np.flatnonzero(left > 0)
+    return c, left[c]
 
 
 def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement:
@@ -408,13 +453,14 @@ def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement
     if inp.n_faces == 0:  # nothing to refine: every level is the input
         return _compose_cut(inp, _unrefined(inp))
     budget = Budget(inp.levels, inp.scheme, inp.max_memory)
-    corners = np.flatnonzero(inp.corner)
     uv_corners = np.flatnonzero(inp.uv.corner) if inp.uv is not None else None
     steps, uv_steps = [], []
     face_parent = np.arange(inp.n_faces, dtype=np.int64)
     pairs, sharp, mask = inp.sharp_edges, inp.sharpness, inp.faces_out(inp.face_sharp)
     uv_pairs, uv_sharp = np.empty((0, 2), np.int64), np.empty(0)
+    corner_left = None
     for s in walk(inp, budget, progress=progress):
+        corners, corner_left = _level_corners(inp, s.step)
         parent = face_parents(s.offsets)
         face_parent = face_parent[parent]
         pairs, sharp = child_creases(s.level, s.plan)
@@ -432,8 +478,10 @@ def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement
         uv = Refinement(uv_faces, uv_pairs, uv_sharp, mask, uv_corners, face_parent.copy(), uv_steps,
                         inp.uv.n_uvs, inp.max_memory)
     faces = steps[-1].faces if steps else inp.faces.copy()
+    if not steps:
+        corners, corner_left = _level_corners(inp, 0)
     r = Refinement(faces, pairs, sharp, mask, corners, face_parent, steps, inp.n_vertices, inp.max_memory, uv,
-                   coarse_faces=inp.faces if inp.cut is None else None)
+                   coarse_faces=inp.faces if inp.cut is None else None, corner_sharpness=corner_left)
     return _compose_cut(inp, r)
 
 

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from .._input import as_vertices, open_gate
 from .._topology import Level, build_level
-from .._typing import ArrayLike, LoopWeights, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
 from .._refiner import refinement_of
 from .local import refine_locally
 from .normals import sector_normals, unit
@@ -38,8 +38,12 @@ class LimitSetup:
 
 
 def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                positions=None, feature_angle=None) -> LimitSetup:
+                positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only") -> LimitSetup:
     """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
+
+    A semi-sharp corner is refined uniformly until its sharpness is spent (⌈s⌉ levels): the
+    masks of the level evaluated then see no finite vertex sharpness, so its limit is that of
+    uniform refinement (the old vertices keep their indices, hence the first ``n_keep``).
 
     >>> import numpy as np
     >>> s = setup_limit(np.array([[0, 1, 2]]), None, 1, None, "sqrt3", None, None, None, "loop")
@@ -48,10 +52,14 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, positions=positions,
-                    feature_angle=feature_angle)
+                    feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
     levels, n = inp.levels, inp.n_vertices
+    l_eval = levels
+    if inp.corner_sharpness is not None:
+        finite = inp.corner_sharpness[np.isfinite(inp.corner_sharpness)]
+        l_eval = max(levels, int(np.ceil(finite.max(initial=0.0))))
     # Kobbelt's boundary rule alternates: evaluate where the next step is odd.
-    l_eval = levels + (1 if scheme == "sqrt3" and levels % 2 else 0)
+    l_eval += 1 if scheme == "sqrt3" and l_eval % 2 else 0
     r = refinement_of(dataclasses.replace(inp, levels=l_eval))
     n_keep = r.steps[levels - 1].n_vertices if levels else n
     faces = r.faces
@@ -146,7 +154,8 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
                  n_vertices: int | None = None, scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                  sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                  loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
-                 vertices: ArrayLike | None = None, tol: float = 1e-12, max_levels: int = 60) -> sp.csr_matrix:
+                 vertices: ArrayLike | None = None, tol: float = 1e-12, max_levels: int = 60,
+                 corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> sp.csr_matrix:
     """The limit matrix: where every vertex of a level goes when refined forever.
 
     Parameters
@@ -161,8 +170,9 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         Number of vertices; default ``F.max() + 1``.
     scheme : {"hybrid", "sqrt3", "loop"}
         The subdivision scheme whose limit is meant.
-    sharpness, sharp_faces, corners, loop_weights
-        As for :func:`hybridsub.refine`.
+    sharpness, sharp_faces, corners, corner_sharpness, boundary, loop_weights
+        As for :func:`hybridsub.refine` (a semi-sharp corner's limit is that of uniform
+        refinement: the level evaluated is refined until its sharpness is spent).
     feature_angle : float, optional
         Also keep sharp the edges whose dihedral angle exceeds this many degrees, with their
         corners, as for :func:`hybridsub.limit_positions`; the angles are measured on
@@ -202,7 +212,7 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
             raise ValueError(f"n_vertices={n_vertices} but vertices has {len(Vf)} rows")
         n_vertices = len(Vf)
     s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
     r = s.refinement
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
@@ -217,7 +227,8 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
                     scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                     sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                     loop_weights: LoopWeights = "loop", feature_angle: float | None = None, tol: float = 1e-12,
-                    max_levels: int = 60) -> np.ndarray:
+                    max_levels: int = 60, corner_sharpness: ArrayLike | None = None,
+                    boundary: Boundary = "edge_only") -> np.ndarray:
     """Limit positions of a mesh's vertices: the points of the limit surface they converge to.
 
     Parameters
@@ -226,7 +237,7 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
         Vertex positions.
     F : (m, 3) array_like of int
         Triangles, consistently oriented, every edge in one or two faces.
-    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, tol, max_levels
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, tol, max_levels, corner_sharpness, boundary
         As for :func:`limit_matrix`.
     feature_angle : float, optional
         Also tag the features :func:`hybridsub.detect_features` finds at this angle (degrees),
@@ -251,7 +262,7 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
     s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
     X = s.refinement.apply(Vf)
     if s.level is not None:
         L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
@@ -264,7 +275,8 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
                   scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                   sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                   loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
-                  per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60) -> np.ndarray:
+                  per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60,
+                  corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> np.ndarray:
     """Unit normals of the limit surface at the limit positions of a mesh's vertices.
 
     Smooth vertices get the normal of the limit surface's tangent plane (Kobbelt's and
@@ -279,7 +291,7 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
         Vertex positions.
     F : (m, 3) array_like of int
         Triangles, consistently oriented, every edge in one or two faces.
-    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, feature_angle
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, feature_angle, corner_sharpness, boundary
         As for :func:`limit_positions`.
     per_face_corner : bool
         Return one normal per face corner, ``(m_L, 3, 3)``, instead of one per vertex.
@@ -306,7 +318,7 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
     s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
     r = s.refinement
     F_out = r.steps[levels - 1].faces if levels else r.faces
     if s.level is None:

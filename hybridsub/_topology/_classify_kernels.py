@@ -252,11 +252,15 @@ def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs
     """Fill ``coefficients`` (4, n) with each vertex mask as (self, every neighbour,
     parent-crease neighbours, child-crease neighbours); ``fix_boundary`` pins every
     non-smooth vertex (Kobbelt's odd steps). ``region_of_all`` is every vertex's region when
-    the faces are all sharp or all smooth, −1 when the counts must decide."""
+    the faces are all sharp or all smooth, −1 when the counts must decide. ``corner`` (n,)
+    float64 is each vertex's sharpness (inf: a corner, 0: none): a vertex with s > 0 is a
+    corner this step, one with s > 1 the next as well, and one with 0 < s ≤ 1 joins the
+    semi-sharp blend like a decaying crease (OpenSubdiv's fractional weight at a vertex)."""
     n = counts.shape[1]
     for v in prange(n):
-        rp = vertex_rule(counts[1, v], corner[v])
-        rc = vertex_rule(counts[2, v], corner[v])
+        sv = corner[v]
+        rp = vertex_rule(counts[1, v], sv > 0.0)
+        rc = vertex_rule(counts[2, v], sv > 1.0)
         if fix_boundary and rp != SMOOTH:
             rp = CORNER
             rc = CORNER
@@ -268,7 +272,12 @@ def _vertex_coefficients(counts, s_frac, corner, region_of_all, weight_table, cs
             region = REGION_LOOP
         else:
             region = REGION_MIXED
-        blend = s_frac[v] / counts[3, v] if counts[3, v] > 0 else 0.0
+        decaying = counts[3, v]
+        frac = s_frac[v]
+        if 0.0 < sv <= 1.0:
+            decaying += 1
+            frac += sv
+        blend = frac / decaying if decaying > 0 else 0.0
         val = counts[0, v]
         a, b, p, c = vertex_mask(val, rp, rc, blend, weight_table[region, val], cs, cn)
         coefficients[0, v] = a

@@ -58,7 +58,8 @@ def plan_step(level: Level, corner: np.ndarray, scheme: str, step: int, loop_wei
     faces (UV seams: R4 points, no flip); both halfedges of an edge must agree.
 
     Tags come from the level (``hsharp``, ``face_sharp``: all sharp for ``"loop"``, none for
-    ``"sqrt3"``); ``corner`` (n,) is the corner mask.
+    ``"sqrt3"``); ``corner`` (n,) is the corner mask, or each
+    vertex's sharpness (float64: inf a corner, finite a semi-sharp corner, 0 none).
     """
     c = _classified(level, scheme, step, force_split)
     coefficients = _coefficients(level, c, corner, scheme, step, loop_weights, c.s_frac)
@@ -126,6 +127,7 @@ def _coefficients(level: Level, c: _Classified, corner: np.ndarray, scheme: str,
     table = R.smooth_weight_table(int(c.counts[0].max()) if n else 0, loop_weights)
     cs, cn = R.KOBBELT_BOUNDARY_MASK if sqrt3 else R.CREASE_MASK
     coefficients = np.empty((4, n), np.float64)
+    corner = np.ascontiguousarray(corner if corner.dtype == np.float64 else np.where(corner, np.inf, 0.0))
     (C.vertex_coefficients if K.use_threads(level.n_faces) else C.vertex_coefficients_serial)(
         c.counts, s_frac, corner, c.region_of_all, table, cs, cn, sqrt3 and step % 2 == 1, coefficients)
     return coefficients
