@@ -72,6 +72,7 @@ class RefineInput:
     uv: UVInput | None = None
     cut: Cut | None = None
     uncut: Uncut | None = None
+    hole: np.ndarray | None = None  # (m,) bool: faces not rendered (None: no holes)
 
     @property
     def n_faces(self) -> int:
@@ -96,12 +97,13 @@ _SQRT3_UV = ('scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every
 def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
               sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise", max_memory=None,
               uv_faces=None, n_uvs=None, uv_mode="linear", uv_name="uv_faces", positions=None,
-              feature_angle=None) -> RefineInput:
+              feature_angle=None, holes=None) -> RefineInput:
     """Check one refinement's arguments (those of :func:`hybridsub.refine`) and describe it.
 
     ``positions`` ((n, 3) float64, already checked) and ``feature_angle`` add the features
     :func:`hybridsub.detect_features` finds to the tags; ``uv_name`` is the name errors give
-    the UV faces. Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
+    the UV faces; ``holes`` (a face mask or indices) the faces whose descendants the results
+    leave out (the refinement itself is unchanged). Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
     """
     levels = val.check_options(scheme, levels, loop_weights)
     if uv_faces is None and n_uvs is not None:
@@ -119,6 +121,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     pairs, sharp = val.as_sharp_edges(sharp_edges, sharpness, n)
     face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
     corner = val.as_corner_mask(corners, n)
+    hole = val.as_hole_mask(holes, len(Fi))  # the cut keeps the faces and their order
     level = None
     if feature_angle is not None:  # on the input's level, which then serves the refinement too
         angle = check_angle("feature_angle", feature_angle)
@@ -133,7 +136,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     if scheme == "loop":
         face_sharp[:] = True
     common = dict(levels=levels, scheme=scheme, loop_weights=loop_weights, face_sharp=face_sharp,
-                  faces_as_indices=faces_as_indices, max_memory=max_memory)
+                  faces_as_indices=faces_as_indices, max_memory=max_memory, hole=hole)
     cut = _cut(Fi, n, pairs, sharp) if cut_asked else None
     if cut is None:
         keep = sharp > 0

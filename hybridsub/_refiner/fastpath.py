@@ -25,7 +25,7 @@ from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold,
 from .budget import Budget
 from .linear_uv import linear_uv_apply
 from .loop import walk
-from .refinement import refinement_of
+from .refinement import refinement_of, without_holes
 from .stencils import apply_step
 
 
@@ -38,7 +38,8 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[False] = ...,
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ...,
+              holes: ArrayLike | None = ...) -> tuple[Positions, Faces]: ...
 
 
 @overload
@@ -46,14 +47,15 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               scheme: Scheme = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[True],
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
-              max_memory: MemoryLimit = ..., progress: bool | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
+              max_memory: MemoryLimit = ..., progress: bool | None = ...,
+              holes: ArrayLike | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
 def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop", return_matrix: bool = False,
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
-              max_memory: MemoryLimit = None, progress: bool | None = False,
+              max_memory: MemoryLimit = None, progress: bool | None = False, holes: ArrayLike | None = None,
               ) -> tuple[Positions, Faces] | tuple[Positions, Faces, sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
@@ -93,6 +95,10 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
     progress : bool or None
         Show a progress bar per level (tqdm: a line on stderr, a widget in a notebook); None:
         only where stderr is a terminal.
+    holes : (m,) bool mask or array_like of int, optional
+        Faces not rendered that still shape their neighbours: ``V2`` is as without holes
+        (every vertex kept), ``F2`` leaves out the faces descending from a hole; see
+        :func:`refine`.
 
     Returns
     -------
@@ -124,9 +130,9 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
         raise TypeError("subdivide(V, F, ...) needs the faces F (an (m, 3) array of vertex indices)")
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
-                    max_memory=max_memory, positions=Vf, feature_angle=feature_angle)
-    if return_matrix or inp.cut is not None:  # a cut mesh's positions come through S_1 @ D
-        r = refinement_of(inp, progress)
+                    max_memory=max_memory, positions=Vf, feature_angle=feature_angle, holes=holes)
+    if return_matrix or inp.cut is not None or inp.hole is not None:  # a cut mesh's positions: S_1 @ D
+        r = without_holes(refinement_of(inp, progress), inp.hole)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
     X, faces = _last_level(inp, Vf, progress)
@@ -195,7 +201,7 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
                      corners=None, loop_weights="loop", tags=True, max_memory=None,
-                     non_manifold="raise") -> Iterator[LevelOutput]:
+                     non_manifold="raise", holes=None) -> Iterator[LevelOutput]:
     """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
@@ -203,10 +209,12 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
     any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
     tags nor face parents are computed (nor the last level's twins). ``max_memory`` and
     ``non_manifold`` as in :func:`subdivide` (with ``"cut"`` the levels are those of the cut mesh).
+    ``holes`` is checked here; every level is yielded whole (the caller drops the faces of holes
+    through the face parents).
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    non_manifold=non_manifold)
+                    non_manifold=non_manifold, holes=holes)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], tags=tags)
 
 
