@@ -140,3 +140,14 @@ def test_holes_with_cut_and_uv_faces():
     G = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
     r = hybridsub.refine(G, levels=1, scheme="loop", non_manifold="cut", holes=[2])
     assert len(r.faces) == 8 and not (r.face_parent == 2).any()
+
+
+def test_obj_hole_tags_round_trip(tmp_path):
+    V, F = hybridsub.load_example()
+    m = hybridsub.TaggedMesh(V, F, holes=np.arange(0, 40, 2))
+    hybridsub.write_mesh(str(tmp_path / "h.obj"), m)
+    back = hybridsub.read_mesh(str(tmp_path / "h.obj"))
+    assert back.holes.tolist() == m.holes.tolist() and back.has_tags
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt hole 1/0/0 4\n")
+    with pytest.raises(hybridsub.MeshError, match="hole tag names face 4, but the file has 1 faces"):
+        hybridsub.read_mesh(str(tmp_path / "bad.obj"))

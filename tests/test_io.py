@@ -152,7 +152,8 @@ t interpolateboundary 1/0/0 2
     # interpolateboundary 2 makes vertices 1 and 3, each in a single face, corners too
     assert m.corners.tolist() == [1, 3]
     notes = " ".join(m.notes)
-    assert "hole" in notes and "semi-sharp corners" in notes and "sharpness <= 0" in notes
+    assert m.holes.tolist() == [0]  # t hole: face indices (OpenSubdiv's face holes)
+    assert "hole" not in notes and "semi-sharp corners" in notes and "sharpness <= 0" in notes
     assert "interpolateboundary 2" in notes
 
 

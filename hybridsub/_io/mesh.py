@@ -56,6 +56,9 @@ class TaggedMesh:
         OBJ's ``usemtl`` names, in order of first use.
     face_material : (m,) int64, or None
         Index into ``materials`` of each face (-1: before any ``usemtl``); None without materials.
+    holes : (h,) int64
+        Faces not rendered that still shape their neighbours (OBJ's ``t hole``; pass them to
+        ``holes=``).
 
     Examples
     --------
@@ -79,6 +82,7 @@ class TaggedMesh:
     material_libs: tuple = ()
     materials: tuple = ()
     face_material: np.ndarray | None = None
+    holes: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
 
     @property
     def vertex_uv(self) -> np.ndarray | None:
@@ -106,7 +110,7 @@ class TaggedMesh:
 
     @property
     def has_tags(self) -> bool:
-        return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces))
+        return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces) or len(self.holes))
 
     def tag_arrays(self) -> dict:
         """The tags as arrays by name: ``sharp_edges`` (k, 2), ``sharpness`` (k,) (``inf``:
