@@ -151,3 +151,14 @@ def test_obj_hole_tags_round_trip(tmp_path):
     (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt hole 1/0/0 4\n")
     with pytest.raises(hybridsub.MeshError, match="hole tag names face 4, but the file has 1 faces"):
         hybridsub.read_mesh(str(tmp_path / "bad.obj"))
+
+
+def test_command_line_leaves_out_the_faces_of_obj_holes(tmp_path):
+    from hybridsub._app.cli import main
+    V, F = hybridsub.load_example()
+    src, dst = str(tmp_path / "a.obj"), str(tmp_path / "b.obj")
+    hybridsub.write_mesh(src, hybridsub.TaggedMesh(V, F, holes=np.array([3, 7, 20])))
+    assert main(["subdivide", src, "-o", dst, "--levels", "1", "--scheme", "loop", "--quiet"]) in (0, None)
+    out = hybridsub.read_mesh(dst)
+    V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", holes=[3, 7, 20])
+    assert mesh_difference(out.vertices, out.faces, V1, F1) is None

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._input import open_gate
+from .._input.arrays import as_hole_mask
 from .._refiner import subdivide_face_varying_levels, subdivide_levels
 from .._units import si
 
@@ -36,13 +37,14 @@ class LevelResult:
 
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
                     corners=None, loop_weights="loop", on_level=None, max_memory=None, uv=None, face_uv=None,
-                    uv_mode="linear", non_manifold="raise") -> LevelResult:
+                    uv_mode="linear", non_manifold="raise", holes=None) -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
     as in :func:`hybridsub.subdivide`. With ``uv (t, e)`` and ``face_uv (m, 3)`` the
     face-varying data is refined too (``uv_mode``), seams split as in
-    :func:`hybridsub.subdivide_face_varying`.
+    :func:`hybridsub.subdivide_face_varying`. ``holes`` (face indices or a mask): the faces
+    descending from them are left out of the result (positions unchanged).
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     F = F0 = np.asarray(F, dtype=np.int64)
@@ -59,7 +61,7 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         run = subdivide_face_varying_levels(X, F, uv, face_uv, sharp_edges, levels, scheme=scheme, uv_mode=uv_mode,
                                             **tags)
     else:
-        run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, **tags)
+        run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, holes=holes, **tags)
     t = time.perf_counter()
     for out in run:
         X, F, pairs, sharp, mask = out.X, out.faces, out.sharp_edges, out.sharpness, out.sharp_faces
@@ -84,7 +86,13 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         inp = open_gate(F0, sharp_edges, 0, n_vertices=n0, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
                         corners=corners, loop_weights=loop_weights, non_manifold="cut")
         corners = np.flatnonzero(inp.corner)
-    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total, uv,
+    hole = as_hole_mask(holes, len(F0))
+    mask = np.asarray(mask)
+    if hole is not None:  # the faces of holes left out (subdivide_levels checked them)
+        keep = ~hole[parent]
+        F, mask, parent = F[keep], mask[keep], parent[keep]
+        face_uv = None if face_uv is None else face_uv[keep]
+    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), mask, corners, parent, total, uv,
                        face_uv)
 
 
