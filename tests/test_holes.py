@@ -162,3 +162,20 @@ def test_command_line_leaves_out_the_faces_of_obj_holes(tmp_path):
     out = hybridsub.read_mesh(dst)
     V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", holes=[3, 7, 20])
     assert mesh_difference(out.vertices, out.faces, V1, F1) is None
+
+
+def test_limit_functions_take_holes():
+    V, F = hybridsub.load_example()
+    h = [0, 1, 2]
+    np.testing.assert_array_equal(hybridsub.limit_positions(V, F, holes=h), hybridsub.limit_positions(V, F))
+    N = hybridsub.limit_normals(V, F, per_face_corner=True, levels=1, scheme="loop")
+    Nh = hybridsub.limit_normals(V, F, per_face_corner=True, levels=1, scheme="loop", holes=h)
+    r = hybridsub.refine(F, levels=1, scheme="loop")
+    np.testing.assert_array_equal(Nh, N[~np.isin(r.face_parent, h)])
+    T1, _ = hybridsub.limit_tangents(V, F, per_face_corner=True, scheme="loop", holes=h)
+    assert T1.shape == (len(F) - 3, 3, 3)
+    S = hybridsub.LimitSurface(V, F, scheme="loop", holes=h)
+    P = S.evaluate([5], [[1 / 3, 1 / 3, 1 / 3]])
+    np.testing.assert_array_equal(P, hybridsub.LimitSurface(V, F, scheme="loop").evaluate([5], [[1 / 3] * 3]))
+    with pytest.raises(hybridsub.MeshError, match=r"face\[1\] = 2 is a hole"):
+        S.evaluate([5, 2], [[1 / 3] * 3] * 2)
