@@ -179,3 +179,11 @@ def test_limit_functions_take_holes():
     np.testing.assert_array_equal(P, hybridsub.LimitSurface(V, F, scheme="loop").evaluate([5], [[1 / 3] * 3]))
     with pytest.raises(hybridsub.MeshError, match=r"face\[1\] = 2 is a hole"):
         S.evaluate([5, 2], [[1 / 3] * 3] * 2)
+
+
+def test_subdivide_mesh_takes_holes():
+    trimesh = pytest.importorskip("trimesh")
+    V, F = hybridsub.load_example()
+    out = hybridsub.subdivide_mesh(trimesh.Trimesh(V, F, process=False), 1, scheme="loop", holes=[0, 1])
+    V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", holes=[0, 1])
+    assert mesh_difference(out.vertices, out.faces, V1, F1) is None
