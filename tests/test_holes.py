@@ -187,3 +187,12 @@ def test_subdivide_mesh_takes_holes():
     out = hybridsub.subdivide_mesh(trimesh.Trimesh(V, F, process=False), 1, scheme="loop", holes=[0, 1])
     V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", holes=[0, 1])
     assert mesh_difference(out.vertices, out.faces, V1, F1) is None
+
+
+def test_npz_holes_round_trip(tmp_path):
+    V, F = hybridsub.load_example()
+    m = hybridsub.TaggedMesh(V, F, holes=np.array([1, 5, 9]))
+    hybridsub.write_mesh(str(tmp_path / "h.npz"), m)
+    assert hybridsub.read_mesh(str(tmp_path / "h.npz")).holes.tolist() == [1, 5, 9]
+    hybridsub.write_mesh(str(tmp_path / "n.npz"), hybridsub.TaggedMesh(V, F))
+    assert "holes" not in np.load(str(tmp_path / "n.npz")).files  # files without holes as before

@@ -338,7 +338,7 @@ def color_bytes(colors: np.ndarray) -> np.ndarray:
 
 
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
-              vertex_colors=None, uv=None, face_uv=None) -> TaggedMesh:
+              vertex_colors=None, uv=None, face_uv=None, holes=None) -> TaggedMesh:
     """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays; creases of
     sharpness 0 left out, masks turned into indices, integer colours scaled to [0, 1]).
 
@@ -374,7 +374,8 @@ def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, s
                 raise MeshError(f"face_uv must have the shape of faces {F.shape}, got {FT.shape}")
             if FT.size and (FT.min() < 0 or FT.max() >= len(T)):
                 raise MeshError(f"face_uv holds an index outside 0..{len(T) - 1}")
-    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT)
+    H = np.flatnonzero(as_face_mask(holes, len(F), "holes")[0])
+    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT, holes=H)
 
 
 def describe_tags(mesh: TaggedMesh) -> str:
