@@ -153,7 +153,8 @@ t interpolateboundary 1/0/0 2
     assert m.corners.tolist() == [1, 3]
     assert m.corner_sharpness is None
     notes = " ".join(m.notes)
-    assert "hole" in notes and "sharpness <= 0" in notes
+    assert m.holes.tolist() == [0]  # t hole: face indices (OpenSubdiv's face holes)
+    assert "hole" not in notes and "sharpness <= 0" in notes
     assert "interpolateboundary 2" in notes
 
 

@@ -416,7 +416,8 @@ def refine_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures, path: s
     try:
         res = refine_by_level(X, mesh.faces, levels, scheme=scheme, loop_weights=opts.loop_weights,
                               on_level=bar.update, max_memory="none" if opts.force else None, **uv_args,
-                              non_manifold=opts.non_manifold, boundary=opts.boundary, **feat.tags())
+                              non_manifold=opts.non_manifold, boundary=opts.boundary,
+                              holes=mesh.holes if len(mesh.holes) else None, **feat.tags())
     except MeshError as e:  # the library's advice in the command line's words
         raise PipelineError(f"{path}: " + str(e).replace('pass non_manifold="cut"', "pass --non-manifold cut")
                             .replace('with non_manifold="cut"', "with --non-manifold cut")) from None

@@ -38,14 +38,15 @@ class LevelResult:
 def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sharpness=None, sharp_faces=None,
                     corners=None, loop_weights="loop", on_level=None, max_memory=None, uv=None, face_uv=None,
                     uv_mode="linear", non_manifold="raise", corner_sharpness=None,
-                    boundary="edge_only") -> LevelResult:
+                    boundary="edge_only", holes=None) -> LevelResult:
     """Refine ``F`` and the per-vertex data ``X (n, d)`` level by level.
 
     ``on_level(done, levels, n_faces, seconds)`` is called after each level; ``max_memory``
     as in :func:`hybridsub.subdivide`. With ``uv (t, e)`` and ``face_uv (m, 3)`` the
     face-varying data is refined too (``uv_mode``), seams split as in
-    :func:`hybridsub.subdivide_face_varying`. ``corner_sharpness`` and ``boundary`` as in
-    :func:`hybridsub.subdivide` (``"none"``: the faces at the boundary are left out at the end).
+    :func:`hybridsub.subdivide_face_varying`. ``corner_sharpness``, ``boundary`` and ``holes``
+    as in :func:`hybridsub.subdivide`: the faces descending from holes (and, with ``"none"``,
+    from the faces at the boundary) are left out of the result (positions unchanged).
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     F = F0 = np.asarray(F, dtype=np.int64)
@@ -63,7 +64,7 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         run = subdivide_face_varying_levels(X, F, uv, face_uv, sharp_edges, levels, scheme=scheme, uv_mode=uv_mode,
                                             **tags)
     else:
-        run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, **tags)
+        run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, holes=holes, **tags)
     t = time.perf_counter()
     for out in run:
         X, F, pairs, sharp, mask = out.X, out.faces, out.sharp_edges, out.sharpness, out.sharp_faces
@@ -85,17 +86,18 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
         sharp = np.full(len(pairs), np.inf)
     inp = open_gate(F0, sharp_edges, 0, n_vertices=n0, scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces,
                     corners=corners, loop_weights=loop_weights, non_manifold=non_manifold if levels else "raise",
-                    corner_sharpness=corner_sharpness, boundary=boundary)
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     # the cut's copies and edge_and_corner's vertices are corners too (input vertices keep their numbers);
     # semi-sharp corners spent by the last level are corners no more
     left = None if inp.corner_sharpness is None else inp.corner_sharpness - levels
     corners = np.flatnonzero(inp.corner if left is None else left > 0)
     left = None if left is None or not np.isfinite(left[corners]).any() else left[corners]
-    if inp.hole_faces is not None and levels:  # boundary="none": the faces at the boundary left out
-        keep = ~inp.hole_faces[parent]
-        F, mask, parent = F[keep], np.asarray(mask)[keep], parent[keep]
+    mask = np.asarray(mask)
+    if inp.hole is not None and levels:  # the faces of holes left out
+        keep = ~inp.hole[parent]
+        F, mask, parent = F[keep], mask[keep], parent[keep]
         face_uv = None if face_uv is None else face_uv[keep]
-    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), np.asarray(mask), corners, parent, total, uv,
+    return LevelResult(X, F, np.asarray(pairs), np.asarray(sharp), mask, corners, parent, total, uv,
                        face_uv, left)
 
 

@@ -271,21 +271,35 @@ def as_sharp_edges(sharp_edges, sharpness, n_vertices: int) -> tuple[np.ndarray,
     return E, s
 
 
-def as_face_mask(sharp_faces, n_faces: int) -> tuple[np.ndarray, bool]:
+def as_face_mask(sharp_faces, n_faces: int, name: str = "sharp_faces") -> tuple[np.ndarray, bool]:
     """Boolean (m,) mask, and whether the caller gave indices (True) or a mask (False)."""
     if sharp_faces is None:
         return np.zeros(n_faces, dtype=bool), False
-    A = as_array(sharp_faces, "sharp_faces", 1, "entry")
+    A = as_array(sharp_faces, name, 1, "entry")
     if A.dtype == bool:
         if A.shape != (n_faces,):
             raise MeshError(
-                f"sharp_faces as a boolean mask must have one entry per face, shape ({n_faces},), got {A.shape}"
+                f"{name} as a boolean mask must have one entry per face, shape ({n_faces},), got {A.shape}"
             )
         return A.copy(), False
-    idx = _indices(A, n_faces, "sharp_faces", "face")
+    idx = _indices(A, n_faces, name, "face")
     mask = np.zeros(n_faces, dtype=bool)
     mask[idx] = True
     return mask, True
+
+
+def as_hole_mask(holes, n_faces: int) -> np.ndarray | None:
+    """The (m,) bool mask of ``holes=`` (a mask or face indices), or None when no face is one.
+    Holes on every face leave nothing to render: a ``MeshError``."""
+    if holes is None:
+        return None
+    mask, _ = as_face_mask(holes, n_faces, "holes")
+    if not mask.any():
+        return None
+    if mask.all():
+        raise MeshError(f"holes marks every face ({count_of(n_faces, 'face')}): nothing would be left to render; "
+                        "a hole is a face that shapes its neighbours but is not drawn")
+    return mask
 
 
 def as_corner_mask(corners, n_vertices: int) -> np.ndarray:

@@ -76,8 +76,9 @@ class RefineInput:
     # semi-sharp, else None (``corner`` then says it all); ``corner`` is ``corner_sharpness > 0``
     corner_sharpness: np.ndarray | None = None
     boundary: str = "edge_only"  # VtxBoundaryInterpolation; "edge_and_corner" is in ``corner`` already
-    # (m,) bool: input faces whose refined faces are left out of the output (``boundary="none"``), or None
-    hole_faces: np.ndarray | None = None
+    # (m,) bool: faces not rendered — the caller's holes and, with ``boundary="none"``, the faces
+    # at the boundary (None: none)
+    hole: np.ndarray | None = None
 
     @property
     def n_faces(self) -> int:
@@ -102,13 +103,16 @@ _SQRT3_UV = ('scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every
 def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
               sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise", max_memory=None,
               uv_faces=None, n_uvs=None, uv_mode="linear", uv_name="uv_faces", positions=None,
-              feature_angle=None, corner_sharpness=None, boundary="edge_only") -> RefineInput:
+              feature_angle=None, corner_sharpness=None, boundary="edge_only", holes=None) -> RefineInput:
     """Check one refinement's arguments (those of :func:`hybridsub.refine`) and describe it.
 
     ``positions`` ((n, 3) float64, already checked) and ``feature_angle`` add the features
     :func:`hybridsub.detect_features` finds to the tags; ``uv_name`` is the name errors give
     the UV faces. ``corner_sharpness`` gives the corners' sharpness (semi-sharp corners decay by
-    one a level); ``boundary`` is OpenSubdiv's boundary interpolation (``docs/scheme.md``). Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
+    one a level); ``boundary`` is OpenSubdiv's boundary interpolation (``docs/scheme.md``);
+    ``holes`` (a face mask or indices) the faces whose descendants the results leave out (the
+    refinement itself is unchanged). Raises ``MeshError``, ``TypeError`` or ``ValueError``
+    naming the problem.
     """
     levels = val.check_options(scheme, levels, loop_weights)
     if uv_faces is None and n_uvs is not None:
@@ -127,6 +131,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     face_sharp, faces_as_indices = val.as_face_mask(sharp_faces, len(Fi))
     corner, vsharp = val.as_corner_sharpness(corners, corner_sharpness, n)
     boundary = val.check_boundary(boundary)
+    hole = val.as_hole_mask(holes, len(Fi))  # the cut keeps the faces and their order
     level = None
     if feature_angle is not None:  # on the input's level, which then serves the refinement too
         angle = check_angle("feature_angle", feature_angle)
@@ -152,7 +157,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
         level = level.tag(pairs[keep], sharp[keep], face_sharp)
         corner, vsharp, holes = _boundary_tags(level, boundary, corner, vsharp)
         return RefineInput(Fi, n, sharp_edges=pairs[keep], sharpness=sharp[keep], corner=corner, level=level,
-                           uv=_with_uv_level(uv, level, corner), corner_sharpness=vsharp, hole_faces=holes, **common)
+                           uv=_with_uv_level(uv, level, corner), corner_sharpness=vsharp, hole=_holes(hole, holes), **common)
     cpairs, csharp = map_sharp_edges(cut, Fi, pairs, sharp, n)
     ccorner = corner[cut.origin]
     if scheme != "sqrt3":  # sqrt3 takes no tags: its pieces follow Kobbelt's boundary rule
@@ -164,7 +169,14 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     return RefineInput(cut.faces, cut.n_vertices, sharp_edges=cpairs[keep], sharpness=csharp[keep],
                        corner=ccorner, level=level, uv=_with_uv_level(uv, level, ccorner), cut=cut,
                        uncut=Uncut(Fi, n, pairs[kept], sharp[kept], corner), corner_sharpness=cvsharp,
-                       hole_faces=holes, **common)
+                       hole=_holes(hole, holes), **common)
+
+
+def _holes(asked: np.ndarray | None, at_boundary: np.ndarray | None) -> np.ndarray | None:
+    """The faces not rendered: the caller's holes and those ``boundary="none"`` makes."""
+    if at_boundary is None:
+        return asked
+    return at_boundary if asked is None else asked | at_boundary
 
 
 def _boundary_tags(level: Level, boundary: str, corner: np.ndarray, vsharp: np.ndarray | None):

@@ -56,6 +56,12 @@ class TaggedMesh:
         OBJ's ``usemtl`` names, in order of first use.
     face_material : (m,) int64, or None
         Index into ``materials`` of each face (-1: before any ``usemtl``); None without materials.
+    corner_sharpness : (c,) float64, or None
+        The sharpness of each of ``corners`` (OBJ's ``t corner v/s``; ``inf``: infinitely
+        sharp); None: all infinitely sharp. Pass it to ``corner_sharpness=``.
+    holes : (h,) int64
+        Faces not rendered that still shape their neighbours (OBJ's ``t hole``; pass them to
+        ``holes=``).
 
     Examples
     --------
@@ -80,6 +86,7 @@ class TaggedMesh:
     materials: tuple = ()
     face_material: np.ndarray | None = None
     corner_sharpness: np.ndarray | None = None  # (c,) float64 beside corners (inf: infinite), None: all infinite
+    holes: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
 
     @property
     def vertex_uv(self) -> np.ndarray | None:
@@ -107,7 +114,7 @@ class TaggedMesh:
 
     @property
     def has_tags(self) -> bool:
-        return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces))
+        return bool(len(self.sharp_edges) or len(self.corners) or len(self.sharp_faces) or len(self.holes))
 
     def tag_arrays(self) -> dict:
         """The tags as arrays by name: ``sharp_edges`` (k, 2), ``sharpness`` (k,) (``inf``:
@@ -366,7 +373,7 @@ def color_bytes(colors: np.ndarray) -> np.ndarray:
 
 
 def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, sharp_faces=None,
-              vertex_colors=None, uv=None, face_uv=None, corner_sharpness=None) -> TaggedMesh:
+              vertex_colors=None, uv=None, face_uv=None, corner_sharpness=None, holes=None) -> TaggedMesh:
     """Check and convert write_mesh's arguments into a TaggedMesh (fresh arrays; creases of
     sharpness 0 left out, masks turned into indices, integer colours scaled to [0, 1]).
 
@@ -404,7 +411,8 @@ def as_tagged(vertices, faces, sharp_edges=None, sharpness=None, corners=None, s
                 raise MeshError(f"face_uv must have the shape of faces {F.shape}, got {FT.shape}")
             if FT.size and (FT.min() < 0 or FT.max() >= len(T)):
                 raise MeshError(f"face_uv holds an index outside 0..{len(T) - 1}")
-    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT, corner_sharpness=Cs)
+    H = np.flatnonzero(as_face_mask(holes, len(F), "holes")[0])
+    return TaggedMesh(V.copy() if V is vertices else V, F, E, s, C, S, colors, T, FT, corner_sharpness=Cs, holes=H)
 
 
 def describe_tags(mesh: TaggedMesh) -> str:

@@ -13,7 +13,7 @@ from .mesh import TaggedMesh, as_tagged
 
 #: The arrays of an NPZ mesh file, in the order written (docs/formats.md).
 NPZ_ARRAYS = ("vertices", "faces", "sharp_edges", "sharpness", "corners", "sharp_faces", "vertex_colors", "uv",
-              "face_uv", "corner_sharpness")
+              "face_uv", "corner_sharpness", "holes")
 
 
 def read_npz(path: str) -> TaggedMesh:
@@ -98,7 +98,7 @@ def write_npz(path: str, m: TaggedMesh) -> None:
     with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
         for name in NPZ_ARRAYS:
             A = getattr(m, name)
-            if A is None:
+            if A is None or (name == "holes" and not len(A)):  # written only when there are holes
                 continue
             info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
             info.external_attr = 0o644 << 16

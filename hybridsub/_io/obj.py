@@ -217,10 +217,12 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
     check_faces(path, F, len(V), origin, base=1)
     if face_uv is not None and uv is not None:
         check_indices(path, face_uv, len(uv), "texture coordinate", lambda f: f"face {f}", base=1)
-    edges, sharpness, (corners, corner_s), sharp_faces, tag_notes, boundary_corners = _parse_tags(
+    edges, sharpness, (corners, corner_s), sharp_faces, tag_notes, boundary_corners, holes = _parse_tags(
         path, extras.tags, len(V), len(faces))
     if origin is not None and len(sharp_faces):
         sharp_faces = np.flatnonzero(np.isin(origin, sharp_faces))
+    if origin is not None and len(holes):  # every triangle of a polygon hole is a hole
+        holes = np.flatnonzero(np.isin(origin, holes))
     if boundary_corners:  # OpenSubdiv's VTX_BOUNDARY_EDGE_AND_CORNER
         extra = np.setdiff1d(boundary_corner_vertices(F), corners)
         if corner_s is not None:  # all of them infinitely sharp (OpenSubdiv's SharpenBoundaryVertex)
@@ -236,7 +238,8 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
     if face_material is not None and origin is not None:
         face_material = face_material[origin]
     return TaggedMesh(V, F, edges, sharpness, corners, sharp_faces, colors, uv, face_uv,
-                      tuple(notes + tag_notes), tuple(extras.libs), tuple(extras.names), face_material, corner_s)
+                      tuple(notes + tag_notes), tuple(extras.libs), tuple(extras.names), face_material, corner_s,
+                      holes)
 
 
 def _obj_vertices(path, rows):
@@ -301,7 +304,7 @@ def _tag_values(where: str, w: list[str]) -> tuple[str, list[int], list[float]]:
 
 def _parse_tags(path, tags, n_vertices, n_faces):
     """OpenSubdiv's ``t name nint/nfloat[/nstring] ints floats strings`` lines."""
-    edges, edge_s, corners, corner_s, faces = [], [], [], [], []
+    edges, edge_s, corners, corner_s, faces, holes = [], [], [], [], [], []
     notes, unknown = [], set()
     boundary_corners = False
     for number, w in tags:
@@ -326,6 +329,8 @@ def _parse_tags(path, tags, n_vertices, n_faces):
                 corner_s.append(floats[j if nfloat > 1 else 0])
         elif name in ("sharpface", "sharp_face"):
             faces.extend(ints)
+        elif name == "hole":  # OpenSubdiv's face holes: 0-based face indices
+            holes.extend(ints)
         elif name == "interpolateboundary":
             if ints and ints[0] == 2:
                 boundary_corners = True
@@ -342,7 +347,11 @@ def _parse_tags(path, tags, n_vertices, n_faces):
     bad = (S < 0) | (S >= n_faces)
     if bad.any():
         raise MeshError(f"{path}: sharpface tag names face {int(S[bad][0])}, but the file has {n_faces} faces")
-    return E, s, (C, Cs), np.unique(S), notes, boundary_corners
+    H = np.array(holes, dtype=np.int64)
+    bad = (H < 0) | (H >= n_faces)
+    if bad.any():
+        raise MeshError(f"{path}: hole tag names face {int(H[bad][0])}, but the file has {n_faces} faces")
+    return E, s, (C, Cs), np.unique(S), notes, boundary_corners, np.unique(H)
 
 
 def _tag_creases(path, edges, edge_s, n_vertices, notes):
@@ -444,6 +453,10 @@ def _tag_lines(m: TaggedMesh) -> list[str]:
     for i in range(0, len(S), 16):  # OpenSubdiv's reader takes lines of at most 255 characters
         chunk = S[i:i + 16]
         parts.append(f"t sharpface {len(chunk)}/0/0 " + " ".join(map(str, chunk)) + "\n")
+    H = np.asarray(getattr(m, "holes", np.empty(0, np.int64))).tolist()
+    for i in range(0, len(H), 16):
+        chunk = H[i:i + 16]
+        parts.append(f"t hole {len(chunk)}/0/0 " + " ".join(map(str, chunk)) + "\n")
     return parts
 
 

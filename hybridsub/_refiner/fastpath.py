@@ -39,7 +39,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[False] = ...,
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
               max_memory: MemoryLimit = ..., progress: bool | None = ..., corner_sharpness: ArrayLike | None = ...,
-              boundary: Boundary = ...) -> tuple[Positions, Faces]: ...
+              boundary: Boundary = ..., holes: ArrayLike | None = ...) -> tuple[Positions, Faces]: ...
 
 
 @overload
@@ -48,7 +48,7 @@ def subdivide(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, 
               corners: ArrayLike | None = ..., loop_weights: LoopWeights = ..., return_matrix: Literal[True],
               feature_angle: float | None = ..., non_manifold: NonManifold = ...,
               max_memory: MemoryLimit = ..., progress: bool | None = ..., corner_sharpness: ArrayLike | None = ...,
-              boundary: Boundary = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
+              boundary: Boundary = ..., holes: ArrayLike | None = ...) -> tuple[Positions, Faces, sp.csr_matrix]: ...
 
 
 def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike | None = None, levels: int = 1, *,
@@ -57,6 +57,7 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
               feature_angle: float | None = None, non_manifold: NonManifold = "raise",
               max_memory: MemoryLimit = None, progress: bool | None = False,
               corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+              holes: ArrayLike | None = None,
               ) -> tuple[Positions, Faces] | tuple[Positions, Faces, sp.csr_matrix]:
     """Subdivide a triangle mesh, keeping its sharp features.
 
@@ -101,6 +102,10 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
     progress : bool or None
         Show a progress bar per level (tqdm: a line on stderr, a widget in a notebook); None:
         only where stderr is a terminal.
+    holes : (m,) bool mask or array_like of int, optional
+        Faces not rendered that still shape their neighbours: ``V2`` is as without holes
+        (every vertex kept), ``F2`` leaves out the faces descending from a hole; see
+        :func:`refine`.
 
     Returns
     -------
@@ -133,9 +138,9 @@ def subdivide(V: ArrayLike, F: ArrayLike | None = None, sharp_edges: ArrayLike |
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, positions=Vf, feature_angle=feature_angle,
-                    corner_sharpness=corner_sharpness, boundary=boundary)
-    if return_matrix or inp.cut is not None or inp.hole_faces is not None:  # a cut mesh's through S_1 @ D
-        r = without_holes(inp, refinement_of(inp, progress))
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+    if return_matrix or inp.cut is not None or inp.hole is not None:  # a cut mesh's positions: S_1 @ D
+        r = without_holes(refinement_of(inp, progress), inp.hole)
         V2 = r.apply(Vf).astype(out_dtype, copy=False)
         return (V2, r.faces, r.matrix) if return_matrix else (V2, r.faces)
     X, faces = _last_level(inp, Vf, progress)
@@ -204,7 +209,8 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
 
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
                      corners=None, loop_weights="loop", tags=True, max_memory=None,
-                     non_manifold="raise", corner_sharpness=None, boundary="edge_only") -> Iterator[LevelOutput]:
+                     non_manifold="raise", corner_sharpness=None, boundary="edge_only",
+                     holes=None) -> Iterator[LevelOutput]:
     """Subdivide level by level without forming matrices; yield a :class:`LevelOutput` per step.
 
     The fast path behind :func:`subdivide`, for callers that want each level as it is done
@@ -212,12 +218,12 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
     any (n, d) per-vertex data, already validated as float64. With ``tags=False`` neither
     tags nor face parents are computed (nor the last level's twins). ``max_memory`` and
     ``non_manifold`` as in :func:`subdivide` (with ``"cut"`` the levels are those of the cut mesh);
-    ``corner_sharpness`` and ``boundary`` too, except that ``boundary="none"`` keeps every face
-    here (the command line drops the holes from the last level by their input faces).
+    ``corner_sharpness``, ``boundary`` and ``holes`` too, except that every level is yielded whole
+    (the caller drops the faces of holes, and ``boundary="none"``'s, through the face parents).
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    non_manifold=non_manifold, corner_sharpness=corner_sharpness, boundary=boundary)
+                    non_manifold=non_manifold, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], tags=tags)
 
 

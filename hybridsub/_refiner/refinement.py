@@ -53,6 +53,10 @@ class RefinementStep:
         row); else None.
     uv_matrix : scipy.sparse.csr_matrix or None
         With ``uv_faces``: the step's UV matrix, ``UV_{k+1} = uv_matrix @ UV_k``; else None.
+    holes : (m',) bool or None
+        With ``refine(..., holes=...)``: the faces of level k + 1 descending from a hole. A step
+        holds the whole level its matrix refines (as OpenSubdiv's ``TopologyLevel`` does, with
+        ``IsFaceHole``); the :class:`Refinement`'s own ``faces`` leave the holes out. Else None.
     """
 
     faces: np.ndarray
@@ -65,6 +69,7 @@ class RefinementStep:
     uv_faces: np.ndarray | None = None
     uv_matrix: sp.csr_matrix | None = None
     _far_apart: bool = field(default=False, repr=False)  # level k's Level.far_apart
+    holes: np.ndarray | None = None
 
     @property
     def n_vertices(self) -> int:
@@ -85,9 +90,10 @@ class Refinement:
     Attributes
     ----------
     faces : (m_L, 3) int64
-        Faces of the finest level.
+        Faces of the finest level (with ``holes``: those not descending from a hole).
     sharp_edges, sharpness, sharp_faces, corners
-        Tags of the finest level, in the forms they were given.
+        Tags of the finest level, in the forms they were given (sharp faces as a mask or
+        indices of ``faces``).
     face_parent : (m_L,) int64
         The input face each output face lies in.
     steps : list of RefinementStep
@@ -329,7 +335,8 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
            corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
            non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
            n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False,
-           corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> Refinement:
+           corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+           holes: ArrayLike | None = None) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -394,6 +401,11 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     progress : bool or None
         Show a progress bar per level (tqdm: a line on stderr, a widget in a notebook); None:
         only where stderr is a terminal.
+    holes : (m,) bool mask or array_like of int, optional
+        Faces that are not rendered but still shape their neighbours (OpenSubdiv's face holes,
+        OBJ's ``t hole``): the matrices are those without holes, and the faces descending from
+        a hole (through ``face_parent``) are left out of ``faces``. Every vertex is kept, also
+        one only holes use (as OpenSubdiv does). See ``docs/usage.md``.
 
     Returns
     -------
@@ -416,27 +428,45 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode,
-                    corner_sharpness=corner_sharpness, boundary=boundary)
-    return without_holes(inp, refinement_of(inp, progress))
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+    return without_holes(refinement_of(inp, progress), inp.hole)
 
 
-def without_holes(inp: RefineInput, r: Refinement) -> Refinement:
-    """``r`` with the faces that descend from ``inp.hole_faces`` left out of its finest level
-    (``faces``, ``face_parent``, ``sharp_faces``, ``uv_faces``); vertices, steps and matrices
-    keep them (``boundary="none"``)."""
-    if inp.hole_faces is None or not inp.hole_faces.any():
+def level_holes(steps, hole: np.ndarray) -> list[np.ndarray]:
+    """The hole mask of every level, input first: a face is a hole when the face that emitted
+    it (``face_parent``) is one."""
+    out = [hole]
+    for st in steps:
+        out.append(out[-1][st.face_parent])
+    return out
+
+
+def kept_faces(sharp_faces: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """A sharp-face mask or index list of a level, for the faces ``keep`` leaves (indices
+    renumbered in the kept faces' order)."""
+    sharp_faces = np.asarray(sharp_faces)
+    if sharp_faces.dtype == bool:
+        return sharp_faces[keep]
+    new = np.cumsum(keep) - 1
+    return new[sharp_faces[keep[sharp_faces]]].astype(np.int64)
+
+
+def without_holes(r: Refinement, hole: np.ndarray | None) -> Refinement:
+    """``r`` with the faces descending from a hole left out of ``faces``, ``face_parent``,
+    ``sharp_faces``, ``face_level`` and the UV faces; every step gets its level's ``holes``
+    mask and keeps its whole level. Vertices, matrices and tags are unchanged."""
+    if hole is None:
         return r
-    keep = ~inp.hole_faces[r.face_parent]
-    sf = np.asarray(r.sharp_faces)
-    if sf.dtype == bool:
-        sf = sf[keep]
-    else:
-        sf = np.flatnonzero(np.isin(np.arange(len(keep)), sf)[keep])
+    masks = level_holes(r.steps, hole)
+    steps = [dataclasses.replace(st, holes=h) for st, h in zip(r.steps, masks[1:])]
+    keep = ~masks[-1]
     uv = r.uv_refinement
     if uv is not None:
-        uv = dataclasses.replace(uv, faces=uv.faces[keep], face_parent=uv.face_parent[keep], sharp_faces=sf, _cache={})
-    return dataclasses.replace(r, faces=r.faces[keep], face_parent=r.face_parent[keep], sharp_faces=sf,
-                               uv_refinement=uv, _cache={})
+        uv = dataclasses.replace(uv, faces=uv.faces[keep], face_parent=uv.face_parent[keep],
+                                 sharp_faces=kept_faces(uv.sharp_faces, keep), _cache={})
+    return dataclasses.replace(r, faces=r.faces[keep], face_parent=r.face_parent[keep],
+                               sharp_faces=kept_faces(r.sharp_faces, keep), steps=steps, uv_refinement=uv,
+                               face_level=None if r.face_level is None else r.face_level[keep], _cache={})
 
 
 def _level_corners(inp: RefineInput, k: int) -> tuple[np.ndarray, np.ndarray | None]:

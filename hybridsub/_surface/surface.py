@@ -70,6 +70,10 @@ class LimitSurface:
         vertices and next to split edges beside √3 faces are walked deeper, by a number of
         levels that grows with the log of their distance (at most 56; a smaller ``depth``
         shifts it down): 1e-12 × the diagonal or better everywhere (``docs/limit.md``).
+    holes : (m,) bool mask or array_like of int, optional
+        Faces not rendered (:func:`hybridsub.refine`): they shape the surface of their
+        neighbours as any face does; :meth:`evaluate` (and :meth:`normals`) on a hole is a
+        ``MeshError`` naming the point.
 
     Notes
     -----
@@ -96,11 +100,13 @@ class LimitSurface:
                  scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                  corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                  feature_angle: float | None = None, non_manifold: NonManifold = "raise",
-                 max_memory: MemoryLimit = None, depth: int | None = None):
+                 max_memory: MemoryLimit = None, depth: int | None = None, holes: ArrayLike | None = None):
         X = as_vertices(V)
         inp = open_gate(F, sharp_edges, 0, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                         sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                        non_manifold=non_manifold, max_memory=max_memory, positions=X, feature_angle=feature_angle)
+                        non_manifold=non_manifold, max_memory=max_memory, positions=X, feature_angle=feature_angle,
+                        holes=holes)
+        self._hole = inp.hole  # (m,) bool or None: evaluate refuses these faces
         self._faces_in, self._copy = inp.faces, None
         if inp.cut is not None:  # the surface of the cut mesh (a manifold input), over the caller's vertices
             self._faces_in, self._copy = inp.uncut.faces, inp.cut.origin
@@ -256,6 +262,10 @@ class LimitSurface:
         """
         X = self._data(vertices)
         f, b = self._points(face, bary)
+        if self._hole is not None and self._hole[f].any():
+            j = int(np.flatnonzero(self._hole[f])[0])
+            raise MeshError(f"face[{j}] = {int(f[j])} is a hole (holes=): the limit surface is not rendered there; "
+                            "evaluate its neighbours, or build the LimitSurface without holes")
         n_rows = 3 if derivatives else 1
         res = self._applied(f, b, n_rows, self.depth, X.reshape(len(X), -1))
         res = res.reshape((n_rows, len(f)) + X.shape[1:])

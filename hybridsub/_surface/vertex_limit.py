@@ -14,9 +14,10 @@ from .._input import as_vertices, open_gate
 from .._topology import Level, build_level
 from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
 from .._refiner import refinement_of
+from .._refiner.refinement import level_holes
 from .local import refine_locally
 from .normals import sector_normals, unit
-from .mask_plan import SEC_TRANSIENT, edge_sharpness, plan_level
+from .mask_plan import SEC_FAN, SEC_TRANSIENT, edge_sharpness, plan_level
 
 # ---------------------------------------------------------------------------------------------
 # Input preparation: the mesh refined to the level evaluated, its tags per edge, face, vertex
@@ -35,10 +36,18 @@ class LimitSetup:
     refinement: object  # the Refinement to the evaluated level
     n_keep: int  # vertices of the requested level
     same_level: bool  # evaluated at the requested level (else one finer: Kobbelt's parity)
+    hole: np.ndarray | None = None  # (m,) the input's holes (None: none)
+
+    def kept_faces(self, levels: int) -> np.ndarray | slice:
+        """The faces of level ``levels`` not descending from a hole (a mask, or all)."""
+        if self.hole is None:
+            return slice(None)
+        return ~level_holes(self.refinement.steps[:levels], self.hole)[-1]
 
 
 def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only") -> LimitSetup:
+                positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only",
+                holes=None) -> LimitSetup:
     """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
 
     A semi-sharp corner is refined uniformly until its sharpness is spent (⌈s⌉ levels): the
@@ -52,7 +61,7 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, positions=positions,
-                    feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
+                    feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     levels, n = inp.levels, inp.n_vertices
     l_eval = levels
     if inp.corner_sharpness is not None:
@@ -76,11 +85,11 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     corner = np.zeros(n_eval, dtype=bool)
     corner[np.asarray(r.corners, dtype=np.int64)] = True
     if m == 0:
-        return LimitSetup(None, None, None, face_sharp, corner, r, n_keep, l_eval == levels)
+        return LimitSetup(None, None, None, face_sharp, corner, r, n_keep, l_eval == levels, inp.hole)
     level = build_level(faces, n_eval)
     tagged, esharp = edge_sharpness(level, np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
                                     np.asarray(r.sharpness, np.float64), scheme)
-    return LimitSetup(level, tagged, esharp, face_sharp, corner, r, n_keep, l_eval == levels)
+    return LimitSetup(level, tagged, esharp, face_sharp, corner, r, n_keep, l_eval == levels, inp.hole)
 
 
 def _check_tol(tol, max_levels):
@@ -155,7 +164,8 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
                  sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                  loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
                  vertices: ArrayLike | None = None, tol: float = 1e-12, max_levels: int = 60,
-                 corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> sp.csr_matrix:
+                 corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                 holes: ArrayLike | None = None) -> sp.csr_matrix:
     """The limit matrix: where every vertex of a level goes when refined forever.
 
     Parameters
@@ -185,6 +195,9 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         their weights change by less than this.
     max_levels : int
         At most this many local refinements (a ``RuntimeWarning`` says if ``tol`` was missed).
+    holes : (m,) bool mask or array_like of int, optional
+        Faces not rendered (:func:`hybridsub.refine`): checked, and without effect on the
+        limit, which they shape like any face (every vertex keeps its row).
 
     Returns
     -------
@@ -212,7 +225,8 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
             raise ValueError(f"n_vertices={n_vertices} but vertices has {len(Vf)} rows")
         n_vertices = len(Vf)
     s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
     r = s.refinement
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
@@ -228,7 +242,7 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
                     sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                     loop_weights: LoopWeights = "loop", feature_angle: float | None = None, tol: float = 1e-12,
                     max_levels: int = 60, corner_sharpness: ArrayLike | None = None,
-                    boundary: Boundary = "edge_only") -> np.ndarray:
+                    boundary: Boundary = "edge_only", holes: ArrayLike | None = None) -> np.ndarray:
     """Limit positions of a mesh's vertices: the points of the limit surface they converge to.
 
     Parameters
@@ -237,8 +251,8 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
         Vertex positions.
     F : (m, 3) array_like of int
         Triangles, consistently oriented, every edge in one or two faces.
-    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, tol, max_levels, corner_sharpness, boundary
-        As for :func:`limit_matrix`.
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, tol, max_levels, corner_sharpness, boundary, holes
+        As for :func:`limit_matrix` (holes do not move any limit position).
     feature_angle : float, optional
         Also tag the features :func:`hybridsub.detect_features` finds at this angle (degrees),
         as :func:`hybridsub.subdivide` does.
@@ -262,7 +276,8 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
     s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
     X = s.refinement.apply(Vf)
     if s.level is not None:
         L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
@@ -271,18 +286,50 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     return np.ascontiguousarray(X[: s.n_keep], dtype=out_dtype)
 
 
+def _one_side_sectors(level: Level, sec) -> np.ndarray:
+    """(n,) the sector that gives a vertex with several sectors its one side; -1 where no face is.
+
+    OpenSubdiv's rule (Sdc's crease limit tangent masks take the span counter-clockwise from
+    the first crease edge in the vertex's edge order, which starts at the outgoing edge of its
+    first face): the sector of the vertex's first face corner (in face order) if that corner's
+    outgoing edge starts the sector, else the next sector counter-clockwise.
+    """
+    n = level.n_vertices
+    out = np.full(n, -1, dtype=np.int64)
+    corners = level.faces.ravel()
+    first = np.full(n, len(corners), dtype=np.int64)
+    np.minimum.at(first, corners, np.arange(len(corners)))
+    v = np.flatnonzero(first < len(corners))
+    h0 = first[v]
+    s0 = sec.he_sector[h0]
+    at_start = (sec.slots[sec.slot_start[:-1][s0]] == h0) | ~sec.open[s0]
+    key = sec.vertex * np.int64(n) + sec.first_ring  # the sector of a vertex that starts at q
+    order = np.argsort(key, kind="stable")
+    want = sec.vertex[s0] * np.int64(n) + sec.last_ring[s0]  # the next one starts where s0 ends
+    i = np.minimum(np.searchsorted(key[order], want), len(order) - 1)
+    found = key[order[i]] == want
+    out[v] = np.where(at_start | ~found, s0, order[i])
+    return out
+
+
+CREASE_NORMALS = ("average", "one_side")
+
+
 def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
                   scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                   sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                   loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
                   per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60,
-                  corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> np.ndarray:
+                  corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                  crease_normals: str = "average", holes: ArrayLike | None = None) -> np.ndarray:
     """Unit normals of the limit surface at the limit positions of a mesh's vertices.
 
     Smooth vertices get the normal of the limit surface's tangent plane (Kobbelt's and
     Loop's tangent masks). On a crease each side (sector) has its own normal; a vertex gets
-    the normalized mean of its sectors' unit normals, ``per_face_corner=True`` gives each
-    face corner the normal of its sector (split normals, for shading). ``docs/limit.md``
+    the normalized mean of its sectors' unit normals (``crease_normals="average"``), or the
+    normal of one side (``"one_side"``: the side OpenSubdiv's limit tangents, and so Adobe
+    Lagrange's normals, take, see ``docs/limit.md``); ``per_face_corner=True`` gives
+    each face corner the normal of its sector (split normals, for shading). ``docs/limit.md``
     says what each kind of vertex gets, and where the limit surface has no tangent plane.
 
     Parameters
@@ -298,6 +345,14 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     tol, max_levels
         For the vertices without stationary tangent masks, refined locally until the normal
         changes by less than ``tol`` (or ``max_levels`` levels).
+    crease_normals : {"average", "one_side"}
+        The normal of a vertex with several sectors (crease, corner): the normalized mean of
+        its sectors' normals, or the normal of OpenSubdiv's side: the sector of its first face
+        corner (in face order) when that corner's outgoing edge is a crease, else the next sector
+        counter-clockwise.
+    holes : (m,) bool mask or array_like of int, optional
+        Faces not rendered (:func:`hybridsub.refine`): they shape the normals like any face;
+        ``per_face_corner`` leaves out the rows of the faces descending from them.
 
     Returns
     -------
@@ -314,21 +369,132 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     >>> np.allclose(N, V / np.sqrt(3))                 # outward, by symmetry
     True
     """
+    if not isinstance(crease_normals, str) or crease_normals not in CREASE_NORMALS:
+        raise ValueError(f"crease_normals must be one of {CREASE_NORMALS}, got {crease_normals!r}")
     A = np.asarray(V)
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
     s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary)
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
     r = s.refinement
     F_out = r.steps[levels - 1].faces if levels else r.faces
+    keep = s.kept_faces(levels)
     if s.level is None:
         N = np.zeros((s.n_keep, 3))
-        return np.zeros((len(F_out), 3, 3)) if per_face_corner else N
+        return np.zeros((len(F_out), 3, 3))[keep] if per_face_corner else N
     X = r.apply(Vf)
     _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
     N = _vertex_normals(s.level, plan, nrm, X)
     if per_face_corner:
         if s.same_level:
-            return nrm[plan.sectors.he_sector].reshape(-1, 3, 3)
-        return N[F_out]
+            return nrm[plan.sectors.he_sector].reshape(-1, 3, 3)[keep]
+        return N[F_out][keep]
+    if crease_normals == "one_side":
+        first = _one_side_sectors(s.level, plan.sectors)
+        used = first >= 0
+        N[used] = nrm[first[used]]
     return N[: s.n_keep]
+
+
+def _sector_tangents(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The two tangents of every sector: its tangent masks applied to ``X`` (not normalised);
+    where a sector has none (``SEC_TRANSIENT``, ``SEC_FAN``) or they are degenerate, an
+    orthonormal pair of its normal's plane, the first along the sector's first ring edge.
+    Oriented so that ``t1 × t2`` is on the side of the sector's normal."""
+    T1, T2 = plan.tangent_csr(level.n_vertices)
+    t1, t2 = T1 @ X, T2 @ X
+    cr = np.cross(t1, t2)
+    size = np.linalg.norm(cr, axis=1)
+    scale = np.linalg.norm(t1, axis=1) * np.linalg.norm(t2, axis=1)
+    kind = plan.sec_kind
+    weak = (kind == SEC_TRANSIENT) | (kind == SEC_FAN) | (size <= 1e-12 * scale) | (scale == 0)
+    flip = ~weak & (np.einsum("ij,ij->i", cr, nrm) < 0)  # corners: the two crease tangents in turn
+    t1[flip], t2[flip] = t2[flip].copy(), t1[flip].copy()
+    if weak.any():
+        sec = plan.sectors
+        n = nrm[weak]
+        e = X[sec.first_ring[weak]] - X[sec.vertex[weak]]
+        e = e - np.einsum("ij,ij->i", e, n)[:, None] * n
+        t1[weak] = unit(e)
+        t2[weak] = np.cross(n, t1[weak])
+    return t1, t2
+
+
+def limit_tangents(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
+                   scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
+                   sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
+                   loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
+                   per_face_corner: bool = False, tol: float = 1e-10, max_levels: int = 60,
+                   corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                   holes: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Two tangents of the limit surface at the limit positions of a mesh's vertices.
+
+    The limit tangent masks applied to the positions, as OpenSubdiv's limit stencils
+    (``Far::LimitStencilTable``'s du and dv, ``PrimvarRefiner::Limit`` with tangents) give
+    them: not normalised, and at a smooth vertex depending on where its ring starts (another
+    start turns the pair in its plane; ``T1 × T2`` stays the same). ``T1 × T2`` points to the
+    side :func:`limit_normals` does. A vertex with several sectors (crease, corner) gets the
+    tangents of one side, OpenSubdiv's (the side ``limit_normals(..., crease_normals="one_side")``
+    takes, ``docs/limit.md``); ``per_face_corner=True`` gives
+    every face corner its own sector's. On a crease ``T1`` runs along it (``q_0 − q_k`` of the
+    sector, ``docs/limit.md``) and ``T2`` across; at a corner they are the two crease edges.
+    Where the scheme has no stationary tangent mask (a semi-sharp crease still decaying, a
+    vertex between √3 and Loop faces of the hybrid), the pair is orthonormal, spanning the
+    plane of the normal that local refinement finds, ``T1`` along the sector's first edge.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, feature_angle
+        As for :func:`limit_positions`.
+    per_face_corner : bool
+        Return the tangents of every face corner, two ``(m_L, 3, 3)`` arrays.
+    tol, max_levels, corner_sharpness, boundary, holes
+        As for :func:`limit_normals`.
+
+    Returns
+    -------
+    T1, T2 : (n_L, 3) ndarrays, or (m_L, 3, 3) with ``per_face_corner``
+        Zero at vertices no face uses.
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    >>> T1, T2 = hybridsub.limit_tangents(V, F, scheme="loop")
+    >>> N = hybridsub.limit_normals(V, F, scheme="loop")
+    >>> bool(np.allclose(hybridsub._surface.normals.unit(np.cross(T1, T2)), N))
+    True
+    >>> bool(np.allclose(np.einsum("ij,ij->i", T1, N), 0))     # in the tangent plane
+    True
+    """
+    A = np.asarray(V)
+    Vf = as_vertices(A)
+    tol, max_levels = _check_tol(tol, max_levels)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
+    r = s.refinement
+    F_out = r.steps[levels - 1].faces if levels else r.faces
+    keep = s.kept_faces(levels)
+    if s.level is None:
+        z = np.zeros((len(F_out), 3, 3))[keep] if per_face_corner else np.zeros((s.n_keep, 3))
+        return z, z.copy()
+    X = r.apply(Vf)
+    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    t1, t2 = _sector_tangents(s.level, plan, nrm, X)
+    if per_face_corner and s.same_level:
+        h = plan.sectors.he_sector
+        return t1[h].reshape(-1, 3, 3)[keep], t2[h].reshape(-1, 3, 3)[keep]
+    first = _one_side_sectors(s.level, plan.sectors)
+    used = first >= 0
+    T1, T2 = np.zeros((s.level.n_vertices, 3)), np.zeros((s.level.n_vertices, 3))
+    T1[used], T2[used] = t1[first[used]], t2[first[used]]
+    if per_face_corner:  # √3 at an odd level: evaluated one level finer, where these vertices are
+        return T1[F_out][keep], T2[F_out][keep]
+    return T1[: s.n_keep], T2[: s.n_keep]
