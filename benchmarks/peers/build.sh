@@ -18,6 +18,7 @@ if ! command -v "$cxx" >/dev/null 2>&1; then
     echo "skip osd_loop: no C++ compiler ($cxx)"
     echo "skip osd_bfr: no C++ compiler ($cxx)"
     echo "skip osd_stencils: no C++ compiler ($cxx)"
+    echo "skip osd_fvar: no C++ compiler ($cxx)"
     exit 0
 fi
 
@@ -42,9 +43,10 @@ build() {  # build NAME HEADER LIBS...
     fi
 }
 
-declare -A pkg=([cgal_subdiv]=libcgal-dev [osd_loop]=libosd-dev [osd_bfr]=libosd-dev [osd_stencils]=libosd-dev)
+declare -A pkg=([cgal_subdiv]=libcgal-dev [osd_loop]=libosd-dev [osd_bfr]=libosd-dev [osd_stencils]=libosd-dev [osd_fvar]=libosd-dev)
 build cgal_subdiv CGAL/Surface_mesh.h
 build osd_loop opensubdiv/far/topologyRefinerFactory.h -losdCPU
 build osd_bfr opensubdiv/bfr/refinerSurfaceFactory.h -losdCPU
 build osd_stencils opensubdiv/far/stencilTableFactory.h -fopenmp -losdCPU
+build osd_fvar opensubdiv/far/primvarRefiner.h -losdCPU
 exit $status
