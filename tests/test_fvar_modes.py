@@ -1,41 +1,72 @@
-"""OpenSubdiv's face-varying modes (FVarLinearInterpolation) against its own results.
+"""OpenSubdiv's six face-varying modes (``uv_interpolation=``, its FVarLinearInterpolation)
+against OpenSubdiv's own results.
 
-References: tests/data/fvar/ (``python tests/data/fvar/generate.py`` with
-``benchmarks/peers/osd_fvar``), the textured bunny, Loop, levels 1 and 2. The corner rules of
-``hybridsub._topology.uv.mode_corners`` are applied on top of the UV corners of
-``uv_mode="smooth"`` (OpenSubdiv's FVAR_LINEAR_NONE); the public ``uv_interpolation=``
-keyword is not wired yet, so the test sets the UV corners of a checked input directly.
+References: tests/data/fvar/ (``benchmarks/peers/build.sh && python tests/data/fvar/generate.py``),
+the textured bunny scan, Loop, levels 1 and 2, compared per face corner as in
+test_face_varying.py.
 """
 
-import dataclasses
 import os
 
 import numpy as np
 import pytest
 
-from hybridsub._input.gate import open_gate
-from hybridsub._refiner.fastpath import walk_data
-from hybridsub._topology.uv import mode_corners
+import hybridsub
+from meshcompare import mesh_difference
 from test_face_varying import corner_differences
 
 DATA = os.path.join(os.path.dirname(__file__), "data", "fvar")
+MODES = ("none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
 # none / corners_only differ where OpenSubdiv gives a UV index an extra value (the three
-# alternating vertices of test_face_varying); corners_plus1/2 sharpen those, and agree everywhere
+# alternating vertices of test_face_varying); the other modes sharpen those and agree everywhere
 KNOWN = {("none", 1): 11, ("none", 2): 209, ("corners_only", 1): 7, ("corners_only", 2): 133}
 
 
 @pytest.mark.parametrize("levels", [1, 2])
-@pytest.mark.parametrize("mode", ["none", "corners_only", "corners_plus1", "corners_plus2"])
-def test_corner_modes_match_opensubdiv(mode, levels):
+@pytest.mark.parametrize("mode", MODES)
+def test_modes_match_opensubdiv(mode, levels):
     d = np.load(os.path.join(DATA, "bunny10k_textured.input.npz"))
     g = np.load(os.path.join(DATA, f"bunny10k_textured.L{levels}.npz"))
     ref = dict(V=g["V"], F=g["F"], FUV=g["FUV"],
                UV=np.load(os.path.join(DATA, f"bunny10k_textured.{mode}.L{levels}.npz"))["UV"])
-    inp = open_gate(d["F_in"], None, levels, n_vertices=len(d["V_in"]), scheme="loop", uv_faces=d["FUV_in"],
-                    n_uvs=len(d["UV_in"]), uv_mode="smooth", uv_name="FUV")
-    uv = dataclasses.replace(inp.uv, corner=inp.uv.corner | mode_corners(inp.level, inp.uv.level, mode))
-    last = None
-    for last in walk_data(dataclasses.replace(inp, uv=uv), d["V_in"].astype(float), d["UV_in"].astype(float)):
-        pass
-    bad, _ = corner_differences(last.X, last.faces, last.UV, last.uv_faces, ref)
+    V, F, UV, FUV = hybridsub.subdivide_face_varying(d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"], levels=levels,
+                                                     scheme="loop", uv_interpolation=mode)
+    assert mesh_difference(V, F, ref["V"], ref["F"], 1e-12) is None
+    bad, _ = corner_differences(V, F, UV, FUV, ref)
     assert int(bad.sum()) == KNOWN.get((mode, levels), 0)
+
+
+def test_uv_mode_names_are_aliases():
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    FUV = np.array([[0, 1, 2], [3, 4, 5]])
+    for old, new in (("linear", "all"), ("smooth", "none")):
+        a = hybridsub.refine_face_varying(F, FUV, levels=2, uv_mode=old).uv.matrix
+        b = hybridsub.refine_face_varying(F, FUV, levels=2, uv_interpolation=new).uv.matrix
+        assert (a != b).nnz == 0
+    with pytest.raises(ValueError, match="uv_interpolation must be one of"):
+        hybridsub.refine_face_varying(F, FUV, uv_interpolation="smooth")
+    with pytest.raises(ValueError, match="disagree"):
+        hybridsub.refine_face_varying(F, FUV, uv_mode="smooth", uv_interpolation="all")
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid"])
+def test_boundaries_keep_uv_boundary_linear_and_no_seam_modes_agree(scheme, mesh):
+    V, F = mesh("mesh_with_border")
+    rng = np.random.default_rng(3)
+    UV = rng.random((len(V), 2))
+    lin = hybridsub.refine_face_varying(F, F, levels=2, scheme=scheme, uv_interpolation="all").uv
+    bnd = hybridsub.refine_face_varying(F, F, levels=2, scheme=scheme, uv_interpolation="boundaries").uv
+    # boundary values of "boundaries" are those of linear interpolation
+    Fb = bnd.faces
+    he = np.stack([Fb.ravel(), np.roll(Fb, -1, axis=1).ravel()], axis=1)
+    fwd = {tuple(x) for x in he.tolist()}
+    on_boundary = np.unique([a for a, b in he.tolist() if (b, a) not in fwd])
+    assert np.abs(bnd.apply(UV)[on_boundary] - lin.apply(UV)[on_boundary]).max() < 1e-14
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid"])
+def test_closed_mesh_without_seams_refines_uvs_like_positions_in_every_mode_but_all(scheme, mesh):
+    V, F = mesh("icosahedron")
+    for mode in MODES[:-1]:
+        geo, uv = hybridsub.refine_face_varying(F, F, levels=2, scheme=scheme, uv_interpolation=mode)
+        assert abs(uv.matrix - geo.matrix).max() < 1e-15, mode

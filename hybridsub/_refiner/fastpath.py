@@ -177,7 +177,7 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
     for s in walk(inp, budget, topology_last=tags, progress=progress):
         X = apply_step(s.level, s.plan, X)
         if s.uv is not None:
-            if inp.uv.mode == "smooth":
+            if inp.uv.mode != "all":
                 UV = apply_step(s.uv.level, s.uv.plan, UV)
             else:
                 UV = linear_uv_apply(s.uv.level, s.uv.plan, UV)

@@ -323,7 +323,8 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
            scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
            corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
            non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
-           n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False) -> Refinement:
+           n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False,
+           uv_interpolation: str | None = None) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -399,7 +400,8 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
-                    max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode)
+                    max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode,
+                    uv_interpolation=uv_interpolation)
     return refinement_of(inp, progress)
 
 
@@ -439,7 +441,7 @@ def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement
 
 def _uv_step_matrix(inp: RefineInput, s: Step) -> sp.csr_matrix:
     """The UV matrix of one step: the scheme's (``"smooth"``) or linear interpolation."""
-    if inp.uv.mode == "smooth":
+    if inp.uv.mode != "all":
         return step_matrix(s.uv.level, s.uv.plan)
     return linear_uv_matrix(s.uv.level, s.uv.plan)
 

@@ -86,12 +86,21 @@ def linear_rows(uvl: Level, plan) -> tuple[np.ndarray, np.ndarray, bool]:
     return E, T, bool((E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any())
 
 
-def uv_start(level: Level, T: np.ndarray, t: int, corner: np.ndarray) -> tuple[Level, np.ndarray]:
-    """The UV index mesh of level 0 and its UV corner mask (t,): carried corner tags and
-    irregular UV indices. Both keep their status from level to level, and new UV values are
-    neither (each lies on one new vertex, in one sector)."""
+def uv_start(level: Level, T: np.ndarray, t: int, corner: np.ndarray, mode: str = "none") -> tuple[Level, np.ndarray]:
+    """The UV index mesh of level 0 and its UV corner mask (t,): carried corner tags,
+    irregular UV indices and those the face-varying ``mode`` sharpens (:func:`mode_corners`).
+    They keep their status from level to level; new UV values are corners only in
+    ``"boundaries"``, on UV boundary edges (:func:`new_uv_corners`)."""
     uvl = uv_level(level, T, t)
-    return uvl, carried_corners(level, uvl, corner) | irregular_uv(level, uvl)
+    return uvl, carried_corners(level, uvl, corner) | irregular_uv(level, uvl) | mode_corners(level, uvl, mode)
+
+
+def new_uv_corners(uvl: Level, plan, n_old: int) -> np.ndarray:
+    """(plan.n_new − n_old,) bool for ``"boundaries"``: the new values on UV boundary edges."""
+    add = np.zeros(plan.n_new - n_old, dtype=bool)
+    h = np.flatnonzero((plan.edge_point >= 0) & (uvl.twin < 0))
+    add[plan.edge_point[h] - n_old] = True
+    return add
 
 
 #: OpenSubdiv's ``Sdc::Options::FVarLinearInterpolation`` names, hybridsub's spelling.
@@ -106,13 +115,19 @@ def mode_corners(level: Level, uvl: Level, mode: str) -> np.ndarray:
     both at a vertex with two when either sector holds an interior infinitely sharp edge or
     is split in several pieces. ``"corners_plus2"``: also both at a vertex with two when one
     sector is a single face, and the one UV index at the end of a seam inside the mesh (a dart).
-    ``"none"`` adds nothing. (OpenSubdiv's rules, ``Vtr::FVarLevel``; the semi-sharp
-    dependency of ``corners_plus1/2`` is not included.) Not yet wired to the public API.
+    ``"boundaries"``: every UV index at a vertex on a seam or on the mesh boundary.
+    ``"none"`` and ``"all"`` add nothing. (OpenSubdiv's rules, ``Vtr::FVarLevel``; the
+    semi-sharp dependency of ``corners_plus1/2`` is not included.)
     """
     t, n = uvl.n_vertices, level.n_vertices
     fv, o = level.faces.ravel(), uvl.faces.ravel()
     out = np.zeros(t, dtype=bool)
-    if mode == "none":
+    if mode in ("none", "all"):
+        return out
+    if mode == "boundaries":  # every UV index at a vertex on a seam or on the mesh boundary
+        at = np.zeros(n, dtype=bool)
+        at[fv[uvl.twin < 0]] = True
+        out[o[at[fv]]] = True
         return out
     span = np.bincount(o, minlength=t)
     out |= span == 1
