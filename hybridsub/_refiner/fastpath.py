@@ -212,7 +212,8 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
 
 def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_edges=None, levels: int = 1, *,
                                   scheme="hybrid", uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
-                                  loop_weights="loop", max_memory=None, non_manifold="raise") -> Iterator[LevelOutput]:
+                                  loop_weights="loop", max_memory=None, non_manifold="raise",
+                                  uv_interpolation=None) -> Iterator[LevelOutput]:
     """The face-varying fast path: yield a :class:`LevelOutput` (with ``UV`` and ``uv_faces``)
     per step, no matrix kept.
 
@@ -222,5 +223,6 @@ def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_e
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold)
+                    uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold,
+                    uv_interpolation=uv_interpolation)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], UV)
