@@ -70,3 +70,41 @@ def test_closed_mesh_without_seams_refines_uvs_like_positions_in_every_mode_but_
     for mode in MODES[:-1]:
         geo, uv = hybridsub.refine_face_varying(F, F, levels=2, scheme=scheme, uv_interpolation=mode)
         assert abs(uv.matrix - geo.matrix).max() < 1e-15, mode
+
+
+def _corner_table(V, F, UV, FUV):
+    """Sorted rows (position, UV) of every face corner, rounded: order-free."""
+    rows = np.hstack([V[F.ravel()], UV[FUV.ravel()]])
+    rows = np.round(rows, 9) + 0.0
+    return rows[np.lexsort(rows.T[::-1])]
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("scheme", ["loop", "hybrid"])
+def test_mirrored_mesh_gives_mirrored_uvs(mode, scheme, mesh):
+    from test_face_varying import uv_from_cuts
+    V, F = mesh("mesh_with_border")
+    cuts = [tuple(F[0, :2]), tuple(F[5, 1:])]
+    UV, FUV = uv_from_cuts(F, cuts, np.random.default_rng(7))
+    a = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, scheme=scheme, uv_interpolation=mode)
+    M, Muv = np.array([-1.0, 1, 1]), np.array([-1.0, 1])
+    b = hybridsub.subdivide_face_varying(V * M, F[:, ::-1], UV * Muv, FUV[:, ::-1], levels=2, scheme=scheme,
+                                         uv_interpolation=mode)
+    got = _corner_table(b[0] * M, b[1], b[2] * Muv, b[3])
+    assert np.array_equal(_corner_table(*a), got)
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_refined_uvs_converge(mode, mesh):
+    """The UV values of the coarse UV indices move less and less from level to level."""
+    from test_face_varying import uv_from_cuts
+    V, F = mesh("mesh_with_border")
+    UV, FUV = uv_from_cuts(F, [tuple(F[0, :2]), tuple(F[5, 1:])], np.random.default_rng(7))
+    moves = []
+    prev = UV
+    for levels in range(1, 5):
+        _, _, UV2, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=levels, scheme="hybrid",
+                                                        uv_interpolation=mode)
+        moves.append(np.abs(UV2[:len(UV)] - prev[:len(UV)]).max())
+        prev = UV2
+    assert all(b <= 0.5 * a + 1e-15 for a, b in zip(moves[1:], moves[2:])), moves
