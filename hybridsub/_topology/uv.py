@@ -103,10 +103,6 @@ def new_uv_corners(uvl: Level, plan, n_old: int) -> np.ndarray:
     return add
 
 
-#: OpenSubdiv's ``Sdc::Options::FVarLinearInterpolation`` names, hybridsub's spelling.
-UV_INTERPOLATIONS = ("none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
-
-
 def mode_corners(level: Level, uvl: Level, mode: str) -> np.ndarray:
     """(t,) bool: the UV indices a corner-sharpening mode adds to the UV corners of level 0.
 
