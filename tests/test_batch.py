@@ -301,7 +301,7 @@ def test_semi_sharp_features_and_smooth_uvs_as_subdivide(cluster, tmp_path):
         hybridsub.batch(str(src), str(outdir), scheduler=cluster, feature_sharpness=2)
     with pytest.raises(ValueError, match="feature_sharpness must be a number > 0"):
         hybridsub.batch(str(src), str(outdir), scheduler=cluster, feature_angle=30, feature_sharpness=0)
-    with pytest.raises(ValueError, match="uv_mode must be 'linear' or 'smooth'"):
+    with pytest.raises(ValueError, match="uv_mode must be one of"):
         hybridsub.batch(str(src), str(outdir), scheduler=cluster, uv_mode="cubic")
 
 

@@ -476,6 +476,13 @@ def test_textured_obj_round_trips(tmp_path, capsys):
         assert np.allclose(m.vertices, V2, atol=1e-13, rtol=0) and np.allclose(m.uv, UV2, atol=1e-13, rtol=0)
     assert np.array_equal(read_mesh(tmp_path / "s2.obj").uv, UV2)  # one run: to the bit
     assert capsys.readouterr().err == ""
+    for mode in ("corners_plus1", "boundaries"):
+        assert main(["subdivide", path, "-o", str(tmp_path / f"{mode}.obj"), "--levels", "2", "--scheme", "loop",
+                     "--uv-interpolation", mode, "-q"]) == 0
+        _, _, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, scheme="loop",
+                                                           uv_interpolation=mode)
+        m = read_mesh(tmp_path / f"{mode}.obj")
+        assert np.array_equal(m.uv, UV2) and np.array_equal(m.face_uv, FUV2), mode
 
 
 def test_textured_obj_with_sqrt3_and_other_formats(tmp_path, capsys):

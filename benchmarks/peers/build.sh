@@ -21,6 +21,7 @@ if ! command -v "$cxx" >/dev/null 2>&1; then
     echo "skip osd_vtags: no C++ compiler ($cxx)"
     echo "skip osd_holes: no C++ compiler ($cxx)"
     echo "skip osd_tangents: no C++ compiler ($cxx)"
+    echo "skip osd_fvar: no C++ compiler ($cxx)"
     exit 0
 fi
 
@@ -45,7 +46,7 @@ build() {  # build NAME HEADER LIBS...
     fi
 }
 
-declare -A pkg=([cgal_subdiv]=libcgal-dev [osd_loop]=libosd-dev [osd_bfr]=libosd-dev [osd_stencils]=libosd-dev [osd_vtags]=libosd-dev [osd_holes]=libosd-dev [osd_tangents]=libosd-dev)
+declare -A pkg=([cgal_subdiv]=libcgal-dev [osd_loop]=libosd-dev [osd_bfr]=libosd-dev [osd_stencils]=libosd-dev [osd_vtags]=libosd-dev [osd_holes]=libosd-dev [osd_tangents]=libosd-dev [osd_fvar]=libosd-dev)
 build cgal_subdiv CGAL/Surface_mesh.h
 build osd_loop opensubdiv/far/topologyRefinerFactory.h -losdCPU
 build osd_bfr opensubdiv/bfr/refinerSurfaceFactory.h -losdCPU
@@ -53,4 +54,5 @@ build osd_stencils opensubdiv/far/stencilTableFactory.h -fopenmp -losdCPU
 build osd_vtags opensubdiv/far/topologyRefinerFactory.h -losdCPU
 build osd_holes opensubdiv/far/topologyRefinerFactory.h -losdCPU
 build osd_tangents opensubdiv/far/primvarRefiner.h -losdCPU
+build osd_fvar opensubdiv/far/primvarRefiner.h -losdCPU
 exit $status

@@ -190,8 +190,9 @@ def batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights
             raise ValueError("feature_sharpness sets the sharpness of detected creases: give feature_angle too")
         feature_sharpness = float(normalize_sharpness(feature_sharpness))
         feature_sharpness = None if math.isinf(feature_sharpness) else feature_sharpness  # JSON has no inf
-    if uv_mode not in (None, "linear", "smooth"):
-        raise ValueError(f"uv_mode must be 'linear' or 'smooth', got {uv_mode!r}")
+    names = ("linear", "smooth", "none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
+    if uv_mode not in (None,) + names:
+        raise ValueError(f"uv_mode must be one of {names}, got {uv_mode!r}")
     return {"levels": levels, "scheme": scheme, "feature_angle": feature_angle,
             "feature_sharpness": feature_sharpness, "loop_weights": loop_weights, "format": fmt,
             "ignore_tags": bool(ignore_tags), "triangulate": bool(triangulate), "weld": bool(weld), "uv_mode": uv_mode}

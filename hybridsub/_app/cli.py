@@ -369,6 +369,10 @@ def _uv_option(p) -> None:
     p.add_argument("--uv-mode", choices=("linear", "smooth"),
                    help="texture coordinates (OBJ vt, PLY s t): linear (default) interpolates them, seams kept, "
                         "the texture undistorted; smooth subdivides them like the positions")
+    p.add_argument("--uv-interpolation", dest="uv_mode",
+                   choices=("none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all"),
+                   help="OpenSubdiv's face-varying modes (FVarLinearInterpolation): what is kept linear at UV "
+                        "seams and boundaries; all = --uv-mode linear, none = --uv-mode smooth")
 
 
 def _scheme_option(p) -> None:

@@ -24,7 +24,7 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
                    feature_angle: float | None = None, loop_weights: LoopWeights = "loop",
                    weld: bool | None = None, uv_mode: UVMode = "linear",
                    non_manifold: NonManifold = "raise", progress: bool | None = False,
-                   holes: ArrayLike | None = None) -> Any:
+                   holes: ArrayLike | None = None, uv_interpolation: str | None = None) -> Any:
     """Subdivide a ``trimesh.Trimesh`` or a ``pyvista.PolyData``, carrying its attributes and
     features along; the result is of the type given.
 
@@ -95,6 +95,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
         With a welded mesh: how UVs (and per-corner data) are refined, as in
         :func:`hybridsub.subdivide_face_varying`. ``"linear"`` (default) never distorts the
         texture.
+    uv_interpolation : {"none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all"}, optional
+        OpenSubdiv's face-varying modes, replacing ``uv_mode`` when given (``docs/face_varying.md``).
     progress : bool or None
         Show a progress bar (tqdm: a line on a terminal, a widget in a notebook) per level;
         None: only where stderr is a terminal.
@@ -136,7 +138,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
         fine = subdivide_mesh(polydata_as_trimesh(mesh), levels, scheme=scheme, sharp_edges=sharp_edges,
                               sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
                               feature_angle=feature_angle, loop_weights=loop_weights, weld=weld, uv_mode=uv_mode,
-                              non_manifold=non_manifold, progress=progress, holes=holes)
+                              non_manifold=non_manifold, progress=progress, holes=holes,
+                              uv_interpolation=uv_interpolation)
         return trimesh_as_polydata(fine, uv_name)
     if kind != "trimesh":
         raise TypeError(f"mesh must be a trimesh.Trimesh or a pyvista.PolyData, got {type(mesh).__name__} "
@@ -172,7 +175,7 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
                    sharp_faces=sharp_faces, corners=corners_w, loop_weights=loop_weights,
                    uv_faces=w.FUV if w.face_varying else None, uv_mode=uv_mode,
                    n_uvs=w.n_corners if w.face_varying else None, non_manifold=non_manifold,
-                   progress=progress, holes=holes)
+                   progress=progress, holes=holes, uv_interpolation=uv_interpolation)
     except MeshError as e:
         if not w.welded:
             raise

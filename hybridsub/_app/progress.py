@@ -61,8 +61,9 @@ def refine_by_level(X, F, levels: int, *, scheme="hybrid", sharp_edges=None, sha
     if uv is not None:
         uv = np.ascontiguousarray(uv, dtype=np.float64)
         face_uv = np.asarray(face_uv, dtype=np.int64)
-        run = subdivide_face_varying_levels(X, F, uv, face_uv, sharp_edges, levels, scheme=scheme, uv_mode=uv_mode,
-                                            **tags)
+        mode = {"linear": "all", "smooth": "none"}.get(uv_mode, uv_mode)  # uv_mode or a uv_interpolation name
+        run = subdivide_face_varying_levels(X, F, uv, face_uv, sharp_edges, levels, scheme=scheme,
+                                            uv_interpolation=mode, **tags)
     else:
         run = subdivide_levels(X, F, sharp_edges, levels, scheme=scheme, holes=holes, **tags)
     t = time.perf_counter()

@@ -29,10 +29,28 @@ NON_MANIFOLD = ("raise", "cut")
 UV_MODES = ("linear", "smooth")
 
 
+UV_INTERPOLATIONS = ("none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
+_UV_MODE_AS = {"linear": "all", "smooth": "none"}
+
+
 def check_uv_mode(uv_mode) -> str:
     if not isinstance(uv_mode, str) or uv_mode not in UV_MODES:
         raise ValueError(f"uv_mode must be one of {UV_MODES}, got {uv_mode!r}")
     return uv_mode
+
+
+def check_uv_interpolation(uv_interpolation, uv_mode="linear") -> str:
+    """The face-varying mode of a call, one of :data:`UV_INTERPOLATIONS` (OpenSubdiv's
+    ``FVarLinearInterpolation``): ``uv_interpolation`` when given, else ``uv_mode``'s
+    (``"linear"`` is ``"all"``, ``"smooth"`` is ``"none"``)."""
+    check_uv_mode(uv_mode)
+    if uv_interpolation is None:
+        return _UV_MODE_AS[uv_mode]
+    if not isinstance(uv_interpolation, str) or uv_interpolation not in UV_INTERPOLATIONS:
+        raise ValueError(f"uv_interpolation must be one of {UV_INTERPOLATIONS}, got {uv_interpolation!r}")
+    if uv_mode != "linear" and _UV_MODE_AS[uv_mode] != uv_interpolation:
+        raise ValueError(f"uv_mode={uv_mode!r} and uv_interpolation={uv_interpolation!r} disagree; give one")
+    return uv_interpolation
 
 
 def count_of(k: int, word: str) -> str:

@@ -31,7 +31,7 @@ class UVInput:
 
     faces: np.ndarray  # (m, 3) int64 UV index of each face corner
     n_uvs: int
-    mode: str  # "linear" or "smooth"
+    mode: str  # one of arrays.UV_INTERPOLATIONS ("all": linear, "none": smooth)
     level: Level | None = None  # the UV index mesh (None until the geometry's level exists)
     corner: np.ndarray | None = None  # (t,) bool: UV indices kept as corners
 
@@ -103,7 +103,8 @@ _SQRT3_UV = ('scheme="sqrt3" cannot honour UV seams (Kobbelt\'s √3 flips every
 def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid", sharpness=None,
               sharp_faces=None, corners=None, loop_weights="loop", non_manifold="raise", max_memory=None,
               uv_faces=None, n_uvs=None, uv_mode="linear", uv_name="uv_faces", positions=None,
-              feature_angle=None, corner_sharpness=None, boundary="edge_only", holes=None) -> RefineInput:
+              feature_angle=None, corner_sharpness=None, boundary="edge_only", holes=None,
+              uv_interpolation=None) -> RefineInput:
     """Check one refinement's arguments (those of :func:`hybridsub.refine`) and describe it.
 
     ``positions`` ((n, 3) float64, already checked) and ``feature_angle`` add the features
@@ -111,8 +112,9 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     the UV faces. ``corner_sharpness`` gives the corners' sharpness (semi-sharp corners decay by
     one a level); ``boundary`` is OpenSubdiv's boundary interpolation (``docs/scheme.md``);
     ``holes`` (a face mask or indices) the faces whose descendants the results leave out (the
-    refinement itself is unchanged). Raises ``MeshError``, ``TypeError`` or ``ValueError``
-    naming the problem.
+    refinement itself is unchanged); ``uv_interpolation`` one of OpenSubdiv's six face-varying
+    modes (``docs/face_varying.md``; ``uv_mode``'s "linear" and "smooth" are "all" and "none").
+    Raises ``MeshError``, ``TypeError`` or ``ValueError`` naming the problem.
     """
     levels = val.check_options(scheme, levels, loop_weights)
     if uv_faces is None and n_uvs is not None:
@@ -120,7 +122,7 @@ def open_gate(F, sharp_edges=None, levels=1, *, n_vertices=None, scheme="hybrid"
     cut_asked = val.check_non_manifold(non_manifold) == "cut"
     if uv_faces is not None and scheme == "sqrt3":
         raise ValueError(_SQRT3_UV)
-    val.check_uv_mode(uv_mode)
+    uv_mode = val.check_uv_interpolation(uv_interpolation, uv_mode)
     Fi, n = val.as_faces(F, n_vertices)
     uv = None
     if uv_faces is not None:
@@ -205,7 +207,7 @@ def _boundary_tags(level: Level, boundary: str, corner: np.ndarray, vsharp: np.n
 def _with_uv_level(uv: UVInput | None, level: Level, corner: np.ndarray) -> UVInput | None:
     if uv is None or level.n_faces == 0:
         return uv
-    uvl, uv_corner = uv_start(level, uv.faces, uv.n_uvs, corner)
+    uvl, uv_corner = uv_start(level, uv.faces, uv.n_uvs, corner, uv.mode)
     return UVInput(uv.faces, uv.n_uvs, uv.mode, uvl, uv_corner)
 
 

@@ -97,7 +97,7 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
                         uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                         sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                         loop_weights: LoopWeights = "loop", non_manifold: NonManifold = "raise",
-                        max_memory: MemoryLimit = None) -> FaceVaryingRefinement:
+                        max_memory: MemoryLimit = None, uv_interpolation: str | None = None) -> FaceVaryingRefinement:
     """Refine a mesh's connectivity together with its face-varying (UV) index mesh.
 
     ``refine(F, ..., uv_faces=FUV)`` returns the ``geometry`` part of this, with the UV faces
@@ -126,6 +126,9 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
         (OpenSubdiv's ``FVAR_LINEAR_ALL``). ``"smooth"``: the scheme's rules on the UV index
         mesh, its boundary (mesh boundary and seams) as creases (OpenSubdiv's
         ``FVAR_LINEAR_NONE``, see ``docs/face_varying.md`` for the one difference).
+    uv_interpolation : {"none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all"}, optional
+        OpenSubdiv's ``FVarLinearInterpolation`` modes (``docs/face_varying.md``); when given
+        it replaces ``uv_mode`` (``"linear"`` is ``"all"``, ``"smooth"`` is ``"none"``).
 
     Returns
     -------
@@ -142,7 +145,8 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     """
     geo = refine(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                  sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
-                 max_memory=max_memory, uv_faces=FUV, n_uvs=n_uvs, uv_mode=uv_mode)
+                 max_memory=max_memory, uv_faces=FUV, n_uvs=n_uvs, uv_mode=uv_mode,
+                 uv_interpolation=uv_interpolation)
     assert geo.uv_refinement is not None  # refine attaches it whenever uv_faces is given
     return FaceVaryingRefinement(geo, geo.uv_refinement)
 
@@ -155,7 +159,8 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            sharp_edges: ArrayLike | None = None, levels: int = 1, *, scheme: Scheme = ...,
                            uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
                            corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
-                           return_matrix: Literal[False] = ..., max_memory: MemoryLimit = ...) -> _Textured: ...
+                           return_matrix: Literal[False] = ..., max_memory: MemoryLimit = ...,
+                           uv_interpolation: str | None = ...) -> _Textured: ...
 
 
 @overload
@@ -164,7 +169,7 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
                            corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
                            return_matrix: Literal[True], max_memory: MemoryLimit = ...,
-                           ) -> tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64],
+                           uv_interpolation: str | None = ...) -> tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64],
                                       sp.csr_matrix, sp.csr_matrix]: ...
 
 
@@ -173,7 +178,7 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                            sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                            loop_weights: LoopWeights = "loop", return_matrix: bool = False,
-                           max_memory: MemoryLimit = None) -> tuple:  # see the overloads above
+                           max_memory: MemoryLimit = None, uv_interpolation: str | None = None) -> tuple:
     """Subdivide a textured triangle mesh: positions and UVs with seams, faces kept aligned.
 
     Parameters
@@ -196,6 +201,9 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
         ``"linear"`` (default): UVs are interpolated linearly, textures never distort
         (OpenSubdiv ``FVAR_LINEAR_ALL``). ``"smooth"``: UVs are subdivided like positions, UV
         boundaries and seams as creases (OpenSubdiv ``FVAR_LINEAR_NONE``).
+    uv_interpolation : {"none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all"}, optional
+        OpenSubdiv's ``FVarLinearInterpolation`` modes (``docs/face_varying.md``); when given
+        it replaces ``uv_mode`` (``"linear"`` is ``"all"``, ``"smooth"`` is ``"none"``).
     return_matrix : bool
         Also return the composite matrices ``S`` (``V2 == S @ V``) and ``S_uv``
         (``UV2 == S_uv @ UV``).
@@ -228,13 +236,15 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
     if return_matrix:
         r = refine_face_varying(F, FUV, sharp_edges, levels, n_vertices=len(Vf), n_uvs=len(UVf), scheme=scheme,
                                 uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                                loop_weights=loop_weights, max_memory=max_memory)
+                                loop_weights=loop_weights, max_memory=max_memory,
+                                uv_interpolation=uv_interpolation)
         V2 = r.geometry.apply(Vf).astype(out_dtype, copy=False)
         UV2 = r.uv.apply(UVf).astype(uv_dtype, copy=False)
         return V2, r.geometry.faces, UV2, r.uv.faces, r.geometry.matrix, r.uv.matrix
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
-                    uv_faces=FUV, n_uvs=len(UVf), uv_mode=uv_mode, uv_name="FUV")
+                    uv_faces=FUV, n_uvs=len(UVf), uv_mode=uv_mode, uv_name="FUV",
+                    uv_interpolation=uv_interpolation)
     last = None
     for last in walk_data(inp, Vf, UVf.reshape(len(UVf), -1)):
         pass

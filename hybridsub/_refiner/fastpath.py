@@ -191,7 +191,7 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
     for s in walk(inp, budget, topology_last=tags, progress=progress):
         X = apply_step(s.level, s.plan, X)
         if s.uv is not None:
-            if inp.uv.mode == "smooth":
+            if inp.uv.mode != "all":
                 UV = apply_step(s.uv.level, s.uv.plan, UV)
             else:
                 UV = linear_uv_apply(s.uv.level, s.uv.plan, UV)
@@ -230,7 +230,7 @@ def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharp
 def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_edges=None, levels: int = 1, *,
                                   scheme="hybrid", uv_mode="linear", sharpness=None, sharp_faces=None, corners=None,
                                   loop_weights="loop", max_memory=None, non_manifold="raise", corner_sharpness=None,
-                                  boundary="edge_only") -> Iterator[LevelOutput]:
+                                  boundary="edge_only", uv_interpolation=None) -> Iterator[LevelOutput]:
     """The face-varying fast path: yield a :class:`LevelOutput` (with ``UV`` and ``uv_faces``)
     per step, no matrix kept.
 
@@ -241,5 +241,5 @@ def subdivide_face_varying_levels(X: np.ndarray, F, UV: np.ndarray, FUV, sharp_e
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
                     uv_faces=FUV, n_uvs=len(UV), uv_mode=uv_mode, uv_name="FUV", non_manifold=non_manifold,
-                    corner_sharpness=corner_sharpness, boundary=boundary)
+                    corner_sharpness=corner_sharpness, boundary=boundary, uv_interpolation=uv_interpolation)
     yield from walk_data(inp, X if inp.cut is None else X[inp.cut.origin], UV)

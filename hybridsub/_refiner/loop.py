@@ -23,6 +23,7 @@ import numpy as np
 from .._input.gate import RefineInput
 from .._rules import step_rules as R
 from .._topology import Level, StepPlan, child_level, plan_step
+from .._topology.uv import new_uv_corners
 from .bar import level_bar, tick
 from .budget import Budget
 
@@ -105,7 +106,11 @@ def _steps(inp: RefineInput, budget: Budget | None, topology_last: bool,
         if uvl is not None:
             uv_faces, uv_child, _ = child_level(uvl, uv_plan)
             uv = UVStep(uvl, uv_plan, uv_faces, uv_child)
-            uv_fixed = np.concatenate([uv_fixed, np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)])
+            if inp.uv.mode == "boundaries":
+                added = new_uv_corners(uv.level, uv_plan, len(uv_fixed))
+            else:
+                added = np.zeros(uv_plan.n_new - len(uv_fixed), dtype=bool)
+            uv_fixed = np.concatenate([uv_fixed, added])
             uvl = uv_child
         yield Step(step, level, plan, faces, child, offsets, uv)
         corner = next_corners(corner, plan.n_new)

@@ -336,7 +336,7 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
            non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None,
            n_uvs: int | None = None, uv_mode: UVMode = "linear", progress: bool | None = False,
            corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
-           holes: ArrayLike | None = None) -> Refinement:
+           holes: ArrayLike | None = None, uv_interpolation: str | None = None) -> Refinement:
     """Refine a mesh's connectivity and tags; positions are not needed.
 
     Parameters
@@ -428,7 +428,8 @@ def refine(F: ArrayLike, sharp_edges: ArrayLike | None = None, levels: int = 1, 
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                     max_memory=max_memory, uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode,
-                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
+                    uv_interpolation=uv_interpolation)
     return without_holes(refinement_of(inp, progress), inp.hole)
 
 
@@ -517,7 +518,7 @@ def refinement_of(inp: RefineInput, progress: bool | None = False) -> Refinement
 
 def _uv_step_matrix(inp: RefineInput, s: Step) -> sp.csr_matrix:
     """The UV matrix of one step: the scheme's (``"smooth"``) or linear interpolation."""
-    if inp.uv.mode == "smooth":
+    if inp.uv.mode != "all":
         return step_matrix(s.uv.level, s.uv.plan)
     return linear_uv_matrix(s.uv.level, s.uv.plan)
 

@@ -86,9 +86,63 @@ def linear_rows(uvl: Level, plan) -> tuple[np.ndarray, np.ndarray, bool]:
     return E, T, bool((E[:, 0] == E[:, 1]).any() or (T[:, :2] == T[:, 1:]).any())
 
 
-def uv_start(level: Level, T: np.ndarray, t: int, corner: np.ndarray) -> tuple[Level, np.ndarray]:
-    """The UV index mesh of level 0 and its UV corner mask (t,): carried corner tags and
-    irregular UV indices. Both keep their status from level to level, and new UV values are
-    neither (each lies on one new vertex, in one sector)."""
+def uv_start(level: Level, T: np.ndarray, t: int, corner: np.ndarray, mode: str = "none") -> tuple[Level, np.ndarray]:
+    """The UV index mesh of level 0 and its UV corner mask (t,): carried corner tags,
+    irregular UV indices and those the face-varying ``mode`` sharpens (:func:`mode_corners`).
+    They keep their status from level to level; new UV values are corners only in
+    ``"boundaries"``, on UV boundary edges (:func:`new_uv_corners`)."""
     uvl = uv_level(level, T, t)
-    return uvl, carried_corners(level, uvl, corner) | irregular_uv(level, uvl)
+    return uvl, carried_corners(level, uvl, corner) | irregular_uv(level, uvl) | mode_corners(level, uvl, mode)
+
+
+def new_uv_corners(uvl: Level, plan, n_old: int) -> np.ndarray:
+    """(plan.n_new − n_old,) bool for ``"boundaries"``: the new values on UV boundary edges."""
+    add = np.zeros(plan.n_new - n_old, dtype=bool)
+    h = np.flatnonzero((plan.edge_point >= 0) & (uvl.twin < 0))
+    add[plan.edge_point[h] - n_old] = True
+    return add
+
+
+def mode_corners(level: Level, uvl: Level, mode: str) -> np.ndarray:
+    """(t,) bool: the UV indices a corner-sharpening mode adds to the UV corners of level 0.
+
+    ``"corners_only"``: a UV index used by one face corner (its sector is one face).
+    ``"corners_plus1"``: also every UV index at a vertex with more than two UV indices, and
+    both at a vertex with two when either sector holds an interior infinitely sharp edge or
+    is split in several pieces. ``"corners_plus2"``: also both at a vertex with two when one
+    sector is a single face, and the one UV index at the end of a seam inside the mesh (a dart).
+    ``"boundaries"``: every UV index at a vertex on a seam or on the mesh boundary.
+    ``"none"`` and ``"all"`` add nothing. (OpenSubdiv's rules, ``Vtr::FVarLevel``; the
+    semi-sharp dependency of ``corners_plus1/2`` is not included.)
+    """
+    t, n = uvl.n_vertices, level.n_vertices
+    fv, o = level.faces.ravel(), uvl.faces.ravel()
+    out = np.zeros(t, dtype=bool)
+    if mode in ("none", "all"):
+        return out
+    if mode == "boundaries":  # every UV index at a vertex on a seam or on the mesh boundary
+        at = np.zeros(n, dtype=bool)
+        at[fv[uvl.twin < 0]] = True
+        out[o[at[fv]]] = True
+        return out
+    span = np.bincount(o, minlength=t)
+    out |= span == 1
+    if mode in ("corners_plus1", "corners_plus2"):
+        pairs = np.unique(fv * np.int64(t) + o)
+        n_values = np.bincount(pairs // t, minlength=n)
+        hs = level.hsharp if level.hsharp is not None else np.zeros(len(fv))
+        inf_inside = np.bincount(o[(uvl.twin >= 0) & np.isinf(hs)], minlength=t) > 0
+        split = np.bincount(o[uvl.twin < 0], minlength=t) > 1
+        either = np.zeros(n, dtype=bool)
+        either[fv[inf_inside[o] | split[o]]] = True
+        sharpen = (n_values > 2) | ((n_values == 2) & either)
+        if mode == "corners_plus2":
+            seam_end = np.zeros(n, dtype=bool)
+            seam_end[fv[(uvl.twin < 0) & (level.twin >= 0)]] = True
+            boundary = np.zeros(n, dtype=bool)
+            boundary[fv[level.twin < 0]] = True
+            single = np.zeros(n, dtype=bool)
+            single[fv[span[o] == 1]] = True
+            sharpen |= ((n_values == 2) & single) | ((n_values == 1) & ~boundary & seam_end)
+        out[o[sharpen[fv]]] = True
+    return out
