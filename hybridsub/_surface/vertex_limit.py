@@ -315,6 +315,26 @@ def _one_side_sectors(level: Level, sec) -> np.ndarray:
 CREASE_NORMALS = ("average", "one_side")
 
 
+def _sector_evaluation(V, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
+                       feature_angle, tol, max_levels, corner_sharpness, boundary, holes):
+    """What :func:`limit_normals` and :func:`limit_tangents` share: the setup, the finest
+    level's faces and the rendered ones among them, and ``(X, plan, sector normals)`` of the
+    level evaluated (None without faces)."""
+    Vf = as_vertices(np.asarray(V))
+    tol, max_levels = _check_tol(tol, max_levels)
+    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
+                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
+    r = s.refinement
+    F_out = r.steps[levels - 1].faces if levels else r.faces
+    keep = s.kept_faces(levels)
+    if s.level is None:
+        return s, F_out, keep, None
+    X = r.apply(Vf)
+    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    return s, F_out, keep, (X, plan, nrm)
+
+
 def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 0,
                   scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None,
                   sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
@@ -371,20 +391,13 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     """
     if not isinstance(crease_normals, str) or crease_normals not in CREASE_NORMALS:
         raise ValueError(f"crease_normals must be one of {CREASE_NORMALS}, got {crease_normals!r}")
-    A = np.asarray(V)
-    Vf = as_vertices(A)
-    tol, max_levels = _check_tol(tol, max_levels)
-    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
-    r = s.refinement
-    F_out = r.steps[levels - 1].faces if levels else r.faces
-    keep = s.kept_faces(levels)
-    if s.level is None:
+    s, F_out, keep, ev = _sector_evaluation(V, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners,
+                                            loop_weights, feature_angle, tol, max_levels, corner_sharpness, boundary,
+                                            holes)
+    if ev is None:
         N = np.zeros((s.n_keep, 3))
         return np.zeros((len(F_out), 3, 3))[keep] if per_face_corner else N
-    X = r.apply(Vf)
-    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    X, plan, nrm = ev
     N = _vertex_normals(s.level, plan, nrm, X)
     if per_face_corner:
         if s.same_level:
@@ -473,20 +486,13 @@ def limit_tangents(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = N
     >>> bool(np.allclose(np.einsum("ij,ij->i", T1, N), 0))     # in the tangent plane
     True
     """
-    A = np.asarray(V)
-    Vf = as_vertices(A)
-    tol, max_levels = _check_tol(tol, max_levels)
-    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
-    r = s.refinement
-    F_out = r.steps[levels - 1].faces if levels else r.faces
-    keep = s.kept_faces(levels)
-    if s.level is None:
+    s, F_out, keep, ev = _sector_evaluation(V, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners,
+                                            loop_weights, feature_angle, tol, max_levels, corner_sharpness, boundary,
+                                            holes)
+    if ev is None:
         z = np.zeros((len(F_out), 3, 3))[keep] if per_face_corner else np.zeros((s.n_keep, 3))
         return z, z.copy()
-    X = r.apply(Vf)
-    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    X, plan, nrm = ev
     t1, t2 = _sector_tangents(s.level, plan, nrm, X)
     if per_face_corner and s.same_level:
         h = plan.sectors.he_sector
