@@ -52,34 +52,12 @@ int main(int argc, char** argv) try {
     for (int h : holes)
         if (h < 0 || h >= mesh.n_faces()) throw std::runtime_error("hole index out of range: " + std::to_string(h));
 
-    const std::vector<float> sharpness(creases.size() / 2, Sdc::Crease::SHARPNESS_INFINITE);
-    const std::vector<int> verts_per_face(mesh.n_faces(), 3);
-    Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.n_vertices();
-    desc.numFaces = mesh.n_faces();
-    desc.numVertsPerFace = verts_per_face.data();
-    desc.vertIndicesPerFace = mesh.F.data();
-    desc.numCreases = int(sharpness.size());
-    desc.creaseVertexIndexPairs = creases.data();
-    desc.creaseWeights = sharpness.data();
-    desc.numHoles = int(holes.size());
-    desc.holeIndices = holes.data();
-    Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, Factory::Options(Sdc::SCHEME_LOOP, sdc)));
-    if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+    osd_common::LoopTags tags;
+    tags.creases = creases;
+    tags.holes = holes;
+    std::unique_ptr<Far::TopologyRefiner> refiner(osd_common::create_tagged_loop_refiner(mesh, tags));
     refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(levels));
-
-    Far::PrimvarRefinerReal<double> primvar(*refiner);
-    std::vector<Point> src(reinterpret_cast<const Point*>(mesh.V.data()),
-                           reinterpret_cast<const Point*>(mesh.V.data()) + mesh.n_vertices());
-    for (int level = 1; level <= levels; ++level) {
-        std::vector<Point> dst(refiner->GetLevel(level).GetNumVertices());
-        primvar.Interpolate(level, src, dst);
-        src.swap(dst);
-    }
+    const std::vector<Point> src = osd_common::interpolate_uniformly(*refiner, mesh, levels);
     std::string counts;
     for (int level = 0; level <= levels; ++level) {
         const Far::TopologyLevel& l = refiner->GetLevel(level);

@@ -41,14 +41,8 @@ int main(int argc, char** argv) try {
     Far::TopologyRefiner::UniformOptions uniform(levels);
     uniform.fullTopologyInLastLevel = true;  // PrimvarRefiner::Limit needs it
     if (levels) refiner->RefineUniform(uniform);
+    const std::vector<Point> src = osd_common::interpolate_uniformly(*refiner, mesh, levels);
     Far::PrimvarRefinerReal<double> primvar(*refiner);
-    std::vector<Point> src(reinterpret_cast<const Point*>(mesh.V.data()),
-                           reinterpret_cast<const Point*>(mesh.V.data()) + mesh.n_vertices());
-    for (int level = 1; level <= levels; ++level) {
-        std::vector<Point> dst(refiner->GetLevel(level).GetNumVertices());
-        primvar.Interpolate(level, src, dst);
-        src.swap(dst);
-    }
     const int n = int(src.size());
     std::vector<Point> pos(n), tan1(n), tan2(n);
     primvar.Limit(src, pos, tan1, tan2);

@@ -55,42 +55,19 @@ int main(int argc, char** argv) try {
     const int levels = std::stoi(args.pos[1]);
     if (levels < 0 || levels > 10) throw std::runtime_error("LEVELS must be in 0..10");
     const std::string mode = args.get("boundary", "edge_only");
-    Sdc::Options sdc;
-    if (mode == "edge_only") sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    else if (mode == "edge_and_corner") sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
-    else if (mode == "none") sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE);
+    osd_common::LoopTags tags;
+    if (mode == "edge_only") tags.boundary = Sdc::Options::VTX_BOUNDARY_EDGE_ONLY;
+    else if (mode == "edge_and_corner") tags.boundary = Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER;
+    else if (mode == "none") tags.boundary = Sdc::Options::VTX_BOUNDARY_NONE;
     else throw std::runtime_error("unknown --boundary " + mode);
-    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-    std::vector<int> creases, corners;
-    std::vector<float> crease_s, corner_s;
-    read_tagged(args.get("creases"), 2, creases, crease_s);
-    read_tagged(args.get("corners"), 1, corners, corner_s);
-    const std::vector<int> verts_per_face(mesh.n_faces(), 3);
-    Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.n_vertices();
-    desc.numFaces = mesh.n_faces();
-    desc.numVertsPerFace = verts_per_face.data();
-    desc.vertIndicesPerFace = mesh.F.data();
-    desc.numCreases = int(crease_s.size());
-    desc.creaseVertexIndexPairs = creases.data();
-    desc.creaseWeights = crease_s.data();
-    desc.numCorners = int(corner_s.size());
-    desc.cornerVertexIndices = corners.data();
-    desc.cornerWeights = corner_s.data();
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, Factory::Options(Sdc::SCHEME_LOOP, sdc)));
-    if (!refiner) throw std::runtime_error("TopologyRefinerFactory::Create failed");
+    read_tagged(args.get("creases"), 2, tags.creases, tags.crease_sharpness);
+    read_tagged(args.get("corners"), 1, tags.corners, tags.corner_sharpness);
+    std::unique_ptr<Far::TopologyRefiner> refiner(osd_common::create_tagged_loop_refiner(mesh, tags));
     Far::TopologyRefiner::UniformOptions uniform(levels);
     uniform.fullTopologyInLastLevel = true;  // Limit needs the last level's full topology
     refiner->RefineUniform(uniform);
+    std::vector<Point> src = osd_common::interpolate_uniformly(*refiner, mesh, levels);
     Far::PrimvarRefinerReal<double> primvar(*refiner);
-    std::vector<Point> src(reinterpret_cast<const Point*>(mesh.V.data()),
-                           reinterpret_cast<const Point*>(mesh.V.data()) + mesh.n_vertices());
-    for (int level = 1; level <= levels; ++level) {
-        std::vector<Point> dst(refiner->GetLevel(level).GetNumVertices());
-        primvar.Interpolate(level, src, dst);
-        src.swap(dst);
-    }
     const Far::TopologyLevel& last = refiner->GetLevel(levels);
     harness::Mesh out;
     out.V.assign(reinterpret_cast<const double*>(src.data()), reinterpret_cast<const double*>(src.data()) + 3 * src.size());
