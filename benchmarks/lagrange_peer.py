@@ -111,11 +111,14 @@ def run_section(levels: int, repeat: int, budget: float) -> tuple[list, str]:
     from importlib.metadata import version
 
     hybridsub.set_threads(1)
-    prep_o, run_o, arr_o, creases = ours_task(levels)
-    prep_l, run_l, arr_l = lagrange_task(levels)
-    t_o: Timing = measure(prep_o, run_o, repeat=repeat, budget=budget)
-    t_l: Timing = measure(prep_l, run_l, repeat=repeat, budget=budget)
-    check = compare_outputs(arr_o(run_o(prep_o())), arr_l(run_l(prep_l())), creases, levels)
+    try:
+        prep_o, run_o, arr_o, creases = ours_task(levels)
+        prep_l, run_l, arr_l = lagrange_task(levels)
+        t_o: Timing = measure(prep_o, run_o, repeat=repeat, budget=budget)
+        t_l: Timing = measure(prep_l, run_l, repeat=repeat, budget=budget)
+        check = compare_outputs(arr_o(run_o(prep_o())), arr_l(run_l(prep_l())), creases, levels)
+    finally:
+        hybridsub.set_threads()  # the rest of compare.py runs on every thread again
     ratio = t_o.median / t_l.median
     lines = [f"## The vertex path against Adobe Lagrange {version('adobe-lagrange')} (OpenSubdiv inside), one thread", "",
              f"fandisk, Loop with its 722 creases, {levels} levels: refined faces, limit positions and limit normals "
