@@ -32,15 +32,15 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time, __getattr_
     from ._fit import FitResult, MultiresDetails, fit
     from ._refiner import (FaceVaryingRefinement, Refinement, RefinementStep, get_memory_limit, refine,
                            refine_face_varying, seam_edges, set_memory_limit, subdivide, subdivide_face_varying)
-    from ._surface import (AdaptiveWarning, LimitSurface, limit_matrix, limit_normals, limit_positions, limit_tangents,
-                           refine_adaptive, subdivide_adaptive)
+    from ._surface import (AdaptiveWarning, LimitMesh, LimitSurface, limit_matrix, limit_mesh, limit_normals,
+                           limit_positions, limit_tangents, refine_adaptive, subdivide_adaptive)
 
 #: Where each public name lives (imported when first used).
 _HOMES = {
     "._refiner": ("FaceVaryingRefinement", "Refinement", "RefinementStep", "get_memory_limit", "refine",
                   "refine_face_varying", "seam_edges", "set_memory_limit", "subdivide", "subdivide_face_varying"),
-    "._surface": ("AdaptiveWarning", "LimitSurface", "limit_matrix", "limit_normals", "limit_positions", "limit_tangents",
-                  "refine_adaptive", "subdivide_adaptive"),
+    "._surface": ("AdaptiveWarning", "LimitMesh", "LimitSurface", "limit_matrix", "limit_mesh", "limit_normals",
+                  "limit_positions", "limit_tangents", "refine_adaptive", "subdivide_adaptive"),
     "._fit": ("FitResult", "MultiresDetails", "fit"),
     "._input": ("Features", "detect_features"),
     "._io": ("TaggedMesh", "load_example", "read_mesh", "write_mesh"),
@@ -55,8 +55,8 @@ __all__ = [
     "subdivide", "refine", "Refinement", "RefinementStep", "detect_features", "Features", "MeshError",
     "OutputTooLargeError", "set_memory_limit", "get_memory_limit", "load_example", "subdivide_mesh",
     "read_mesh", "write_mesh", "TaggedMesh", "subdivide_face_varying", "refine_face_varying",
-    "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "limit_tangents", "LimitSurface",
-    "analysis", "batch", "BatchSummary", "set_threads", "MultiresDetails", "fit", "FitResult",
+    "FaceVaryingRefinement", "seam_edges", "limit_matrix", "limit_positions", "limit_normals", "limit_tangents", "limit_mesh",
+    "LimitMesh", "LimitSurface", "analysis", "batch", "BatchSummary", "set_threads", "MultiresDetails", "fit", "FitResult",
     "refine_adaptive", "subdivide_adaptive", "AdaptiveWarning",
 ]
 

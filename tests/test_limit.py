@@ -292,7 +292,7 @@ def test_loop_crease_sector_normals_converge():
     V, F = load_mesh("mesh_with_border")
     Nc = hybridsub.limit_normals(V, F, scheme="loop", per_face_corner=True)
     n = len(V)
-    from hybridsub._surface.vertex_limit import setup_limit
+    from hybridsub._surface.limit_setup import setup_limit
     from hybridsub._surface.mask_plan import plan_level
     s = setup_limit(F, None, 0, n, "loop", None, None, None, "loop")
     pl = plan_level(s.level, s.esharp, s.face_sharp, s.corner, "loop", "loop")

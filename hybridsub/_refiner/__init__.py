@@ -9,7 +9,8 @@ from .budget import (cgroup_memory_limit, get_memory_limit, memory_source, physi
 from .chart import (EQUILATERAL, FaceCharts, barycentric, child_shapes, glue, glue_maps, matrix_supports,
                     onto_input_faces, plan_supports, vertex_origins)
 from .facevarying import FaceVaryingRefinement, refine_face_varying, seam_edges, subdivide_face_varying
-from .fastpath import LevelOutput, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data
+from .fastpath import (LevelOutput, WalkedLevel, subdivide, subdivide_face_varying_levels, subdivide_levels, walk_data,
+                       walk_to)
 from .refinement import Refinement, RefinementStep, refine, refinement_of, without_holes
 from .sharpness import SharpnessSteps, Slopes, sharpness_steps
 from .stencils import (CodedStencils, apply_coded, apply_matrix, coded_stencils, in_read_order,
@@ -21,4 +22,4 @@ __all__ = ["apply_coded", "apply_matrix", "barycentric", "cgroup_memory_limit", 
            "plan_supports", "predict_levels", "refine", "refine_face_varying", "Refinement", "refinement_of", "without_holes",
            "RefinementStep", "seam_edges", "set_memory_limit", "sharpness_steps", "SharpnessSteps", "Slopes",
            "step_matrix", "subdivide", "subdivide_face_varying", "subdivide_face_varying_levels", "subdivide_levels",
-           "vertex_origins", "walk_data"]
+           "vertex_origins", "walk_data", "WalkedLevel", "walk_to"]

@@ -207,6 +207,51 @@ def walk_data(inp: RefineInput, X: np.ndarray, UV: np.ndarray | None = None, tag
         del out
 
 
+@dataclass(frozen=True, eq=False)
+class WalkedLevel:
+    """The last level of :func:`walk_to`, and the faces of the level it was asked to keep."""
+
+    X: np.ndarray  # (n, d) the data at the last level
+    faces: np.ndarray  # (m, 3) the last level's faces
+    face_sharp: np.ndarray  # (m,) bool sharp faces of the last level
+    sharp_edges: np.ndarray  # (k, 2) its tagged creases
+    sharpness: np.ndarray  # (k,)
+    kept_faces: np.ndarray  # (m_at, 3) the faces of level ``at``
+    kept_hole: np.ndarray | None  # (m_at,) which of them descend from a hole (None: no holes)
+    kept_n_vertices: int  # vertices of level ``at``
+
+
+def walk_to(inp: RefineInput, X: np.ndarray, at: int) -> WalkedLevel:
+    """Refine ``X`` (n, d) float64 through ``inp.levels`` steps without forming matrices; the
+    last level with its tags, and the faces of level ``at`` (≤ ``inp.levels``).
+
+    The numbers are those of :meth:`Refinement.apply` before its matrix is formed, bit for bit.
+
+    >>> import numpy as np
+    >>> from hybridsub._input import open_gate
+    >>> inp = open_gate(np.array([[0, 1, 2]]), [[0, 1]], 2, scheme="loop")
+    >>> w = walk_to(inp, np.eye(3), 1)
+    >>> w.X.shape, len(w.faces), len(w.kept_faces), len(w.sharp_edges)
+    ((15, 3), 16, 4, 0)
+    """
+    faces, face_sharp, pairs, sharp = inp.faces, inp.face_sharp, inp.sharp_edges, inp.sharpness
+    hole = inp.hole
+    kept, kept_hole, kept_n = faces, hole, inp.n_vertices
+    topology = inp.scheme == "hybrid" or hole is not None  # the last face tags and parents
+    for s in walk(inp, Budget(inp.levels, inp.scheme, inp.max_memory, keeps_steps=False), topology_last=topology):
+        X = apply_step(s.level, s.plan, X)
+        faces = s.faces
+        if s.step == inp.levels:
+            pairs, sharp = child_creases(s.level, s.plan)
+        face_sharp = s.child.face_sharp if s.child is not None else np.full(len(faces), inp.scheme == "loop")
+        if hole is not None:
+            hole = hole[face_parents(s.offsets)]
+        if s.step == at:
+            kept, kept_hole, kept_n = faces, hole, s.plan.n_new
+        del s
+    return WalkedLevel(X, faces, face_sharp, pairs, sharp, kept, kept_hole, kept_n)
+
+
 def subdivide_levels(X, F, sharp_edges=None, levels=1, *, scheme="hybrid", sharpness=None, sharp_faces=None,
                      corners=None, loop_weights="loop", tags=True, max_memory=None,
                      non_manifold="raise", corner_sharpness=None, boundary="edge_only",

@@ -13,10 +13,10 @@ the output is not yet within a tolerance of the surface (the engine is the refin
 ``docs/limit.md`` explains every decision taken here.
 """
 
-from .vertex_limit import limit_matrix, limit_normals, limit_positions, limit_tangents
+from .vertex_limit import LimitMesh, limit_matrix, limit_mesh, limit_normals, limit_positions, limit_tangents
 from .surface import LimitSurface
 from .adaptive import AdaptiveWarning, refine_adaptive, subdivide_adaptive
 from .mesh_closest import ClosestPoints, Footpoints, closest_points
 
-__all__ = ["AdaptiveWarning", "ClosestPoints", "Footpoints", "LimitSurface", "closest_points", "limit_matrix",
-           "limit_normals", "limit_positions", "limit_tangents", "refine_adaptive", "subdivide_adaptive"]
+__all__ = ["AdaptiveWarning", "ClosestPoints", "Footpoints", "LimitMesh", "LimitSurface", "closest_points",
+           "limit_matrix", "limit_mesh", "limit_normals", "limit_positions", "limit_tangents", "refine_adaptive", "subdivide_adaptive"]

@@ -132,3 +132,46 @@ def run_estimate(level: Level, sec: Sectors, X: np.ndarray, face_sharp: np.ndarr
     flip = np.einsum("ij,ij->i", out, fan) < 0
     out[flip] *= -1.0
     return unit(out), robust
+
+
+def vertex_normals(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Unit normal of every vertex: the normalized sum of its sectors' unit normals."""
+    N = np.zeros((level.n_vertices, 3))
+    np.add.at(N, plan.sectors.vertex, nrm)
+    # Sectors facing opposite ways (a fin: a crease that turns back on itself) cancel; there
+    # the vertex gets its control fan's normal instead.
+    cancel = np.linalg.norm(N, axis=1) < 1e-6
+    if cancel.any():
+        Fl = level.faces
+        fn = np.cross(X[Fl[:, 1]] - X[Fl[:, 0]], X[Fl[:, 2]] - X[Fl[:, 0]])
+        fan = np.zeros_like(N)
+        for i in range(3):
+            np.add.at(fan, Fl[:, i], fn)
+        N[cancel] = fan[cancel]
+    return unit(N)
+
+
+def one_side_sectors(level: Level, sec) -> np.ndarray:
+    """(n,) the sector that gives a vertex with several sectors its one side; -1 where no face is.
+
+    OpenSubdiv's rule (Sdc's crease limit tangent masks take the span counter-clockwise from
+    the first crease edge in the vertex's edge order, which starts at the outgoing edge of its
+    first face): the sector of the vertex's first face corner (in face order) if that corner's
+    outgoing edge starts the sector, else the next sector counter-clockwise.
+    """
+    n = level.n_vertices
+    out = np.full(n, -1, dtype=np.int64)
+    corners = level.faces.ravel()
+    first = np.full(n, len(corners), dtype=np.int64)
+    np.minimum.at(first, corners, np.arange(len(corners)))
+    v = np.flatnonzero(first < len(corners))
+    h0 = first[v]
+    s0 = sec.he_sector[h0]
+    at_start = (sec.slots[sec.slot_start[:-1][s0]] == h0) | ~sec.open[s0]
+    key = sec.vertex * np.int64(n) + sec.first_ring  # the sector of a vertex that starts at q
+    order = np.argsort(key, kind="stable")
+    want = sec.vertex[s0] * np.int64(n) + sec.last_ring[s0]  # the next one starts where s0 ends
+    i = np.minimum(np.searchsorted(key[order], want), len(order) - 1)
+    found = key[order[i]] == want
+    out[v] = np.where(at_start | ~found, s0, order[i])
+    return out

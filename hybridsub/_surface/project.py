@@ -27,7 +27,8 @@ from ._closest_kernels import (bin_faces, closest_among, closest_in_grid, face_r
                                survivor_components)
 from .mask_plan import edge_sharpness
 from .mesh_closest import _grid
-from .vertex_limit import LimitSetup, _evaluate
+from .limit_setup import LimitSetup
+from .level_eval import evaluate_level
 
 #: The certificate's level: the first with at least this many faces (at least one level, at most MAX_LEVELS).
 SEED_FACES = 30000
@@ -119,7 +120,7 @@ def seed_setup(inp: RefineInput) -> SeedMesh:
     tagged, esharp = edge_sharpness(level, np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
                                     np.asarray(r.sharpness, np.float64), inp.scheme)
     s = LimitSetup(level, tagged, esharp, face_sharp, corner, r, n, True)
-    L, _, _ = _evaluate(s, inp.scheme, inp.loop_weights, None, True, 1e-12, 60)
+    L, _, _ = evaluate_level(s, inp.scheme, inp.loop_weights, None, True, 1e-12, 60)
     walls = inp.level.twin.copy()
     if inp.level.hsharp is not None:
         walls[np.isinf(inp.level.hsharp)] = -1

@@ -1,95 +1,23 @@
 """The public limit functions: :func:`limit_matrix`, :func:`limit_positions`,
-:func:`limit_normals`, and the one evaluation of a level they share (plan, then local
-refinement where needed)."""
+:func:`limit_normals`, :func:`limit_tangents`, :func:`limit_mesh`, and the one evaluation of
+a level they share: the vertex lane where it applies (``vertex_lane``), else the plan of every
+vertex, then local refinement where needed."""
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
-from .._input import as_vertices, open_gate
-from .._topology import Level, build_level
+from .._input import as_vertices
+from .._topology import Level
 from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
-from .._refiner import refinement_of
-from .._refiner.refinement import level_holes
-from .local import refine_locally
-from .normals import sector_normals, unit
-from .mask_plan import SEC_FAN, SEC_TRANSIENT, edge_sharpness, plan_level
-
-# ---------------------------------------------------------------------------------------------
-# Input preparation: the mesh refined to the level evaluated, its tags per edge, face, vertex
-# ---------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class LimitSetup:
-    """A mesh and its tags, refined to the level the limit is evaluated at."""
-
-    level: Level | None  # the level evaluated (None: no faces)
-    tagged: np.ndarray
-    esharp: np.ndarray
-    face_sharp: np.ndarray
-    corner: np.ndarray
-    refinement: object  # the Refinement to the evaluated level
-    n_keep: int  # vertices of the requested level
-    same_level: bool  # evaluated at the requested level (else one finer: Kobbelt's parity)
-    hole: np.ndarray | None = None  # (m,) the input's holes (None: none)
-
-    def kept_faces(self, levels: int) -> np.ndarray | slice:
-        """The faces of level ``levels`` not descending from a hole (a mask, or all)."""
-        if self.hole is None:
-            return slice(None)
-        return ~level_holes(self.refinement.steps[:levels], self.hole)[-1]
-
-
-def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only",
-                holes=None) -> LimitSetup:
-    """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
-
-    A semi-sharp corner is refined uniformly until its sharpness is spent (⌈s⌉ levels): the
-    masks of the level evaluated then see no finite vertex sharpness, so its limit is that of
-    uniform refinement (the old vertices keep their indices, hence the first ``n_keep``).
-
-    >>> import numpy as np
-    >>> s = setup_limit(np.array([[0, 1, 2]]), None, 1, None, "sqrt3", None, None, None, "loop")
-    >>> s.same_level, s.n_keep, s.level.n_vertices                 # √3 is evaluated at even levels
-    (False, 4, 10)
-    """
-    inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
-                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, positions=positions,
-                    feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
-    levels, n = inp.levels, inp.n_vertices
-    l_eval = levels
-    if inp.corner_sharpness is not None:
-        finite = inp.corner_sharpness[np.isfinite(inp.corner_sharpness)]
-        l_eval = max(levels, int(np.ceil(finite.max(initial=0.0))))
-    # Kobbelt's boundary rule alternates: evaluate where the next step is odd.
-    l_eval += 1 if scheme == "sqrt3" and l_eval % 2 else 0
-    r = refinement_of(dataclasses.replace(inp, levels=l_eval))
-    n_keep = r.steps[levels - 1].n_vertices if levels else n
-    faces = r.faces
-    n_eval = r.n_vertices
-    m = len(faces)
-    fsh = np.asarray(r.sharp_faces)
-    face_sharp = np.zeros(m, dtype=bool)
-    if fsh.dtype == bool:
-        face_sharp[:] = fsh
-    else:
-        face_sharp[fsh] = True
-    if scheme == "loop":
-        face_sharp[:] = True
-    corner = np.zeros(n_eval, dtype=bool)
-    corner[np.asarray(r.corners, dtype=np.int64)] = True
-    if m == 0:
-        return LimitSetup(None, None, None, face_sharp, corner, r, n_keep, l_eval == levels, inp.hole)
-    level = build_level(faces, n_eval)
-    tagged, esharp = edge_sharpness(level, np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
-                                    np.asarray(r.sharpness, np.float64), scheme)
-    return LimitSetup(level, tagged, esharp, face_sharp, corner, r, n_keep, l_eval == levels, inp.hole)
+from .limit_setup import LimitInput, setup_limit, walk_for_limit
+from .level_eval import evaluate_level
+from .normals import one_side_sectors, unit, vertex_normals
+from .mask_plan import SEC_FAN, SEC_TRANSIENT
+from .vertex_lane import level_limits
 
 
 def _check_tol(tol, max_levels):
@@ -99,59 +27,6 @@ def _check_tol(tol, max_levels):
     if isinstance(max_levels, bool) or int(max_levels) != max_levels or max_levels < 1:
         raise ValueError(f"max_levels must be a positive integer, got {max_levels!r}")
     return tol, int(max_levels)
-
-
-# ---------------------------------------------------------------------------------------------
-# The evaluation of one level
-# ---------------------------------------------------------------------------------------------
-
-
-def _evaluate(s: LimitSetup, scheme, loop_weights, X, want_rows, tol, max_levels):
-    """Limit matrix (n × n CSR, or None), plan and sector normals (or None) of the level evaluated."""
-    level = s.level
-    n = level.n_vertices
-    plan = plan_level(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
-    nrm = sector_normals(level, plan, X) if X is not None else None
-    need = np.zeros(n, dtype=bool)
-    if want_rows:
-        need |= ~plan.pos_ok
-    if X is not None:
-        need[plan.sectors.vertex[plan.sec_kind == SEC_TRANSIENT]] = True
-    centers = np.flatnonzero(need)
-    rows = None
-    if len(centers):
-        rows, est = refine_locally(level, s.tagged, s.face_sharp, s.corner, scheme, loop_weights, centers, plan, X,
-                                   want_rows, tol, max_levels)
-        if X is not None:
-            t = plan.sec_kind == SEC_TRANSIENT
-            nrm[t] = est[t]
-    if not want_rows:
-        return None, plan, nrm
-    L = plan.limit_csr(n)
-    if rows is not None:
-        moved = sp.csr_matrix((np.ones(len(centers)), (centers, np.arange(len(centers)))), shape=(n, len(centers)))
-        L = L + moved @ rows
-    L = sp.csr_matrix(L)
-    L.sum_duplicates()
-    L.sort_indices()
-    return L, plan, nrm
-
-
-def _vertex_normals(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """Unit normal of every vertex: the normalized sum of its sectors' unit normals."""
-    N = np.zeros((level.n_vertices, 3))
-    np.add.at(N, plan.sectors.vertex, nrm)
-    # Sectors facing opposite ways (a fin: a crease that turns back on itself) cancel; there
-    # the vertex gets its control fan's normal instead.
-    cancel = np.linalg.norm(N, axis=1) < 1e-6
-    if cancel.any():
-        Fl = level.faces
-        fn = np.cross(X[Fl[:, 1]] - X[Fl[:, 0]], X[Fl[:, 2]] - X[Fl[:, 0]])
-        fan = np.zeros_like(N)
-        for i in range(3):
-            np.add.at(fan, Fl[:, i], fn)
-        N[cancel] = fan[cancel]
-    return unit(N)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -231,7 +106,7 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
     else:
-        L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
+        L, _, _ = evaluate_level(s, scheme, loop_weights, None, True, tol, max_levels)
     out = sp.csr_matrix((L @ r.matrix)[: s.n_keep])
     out.sort_indices()
     return out
@@ -275,41 +150,21 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     A = np.asarray(V)
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
-    s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
-                    positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
-    X = s.refinement.apply(Vf)
-    if s.level is not None:
-        L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)
-        X = L @ X
+    li = walk_for_limit(Vf, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
+                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+    P, _ = _level_limits(li, Vf, loop_weights, True, False, "average", tol, tol, max_levels)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
-    return np.ascontiguousarray(X[: s.n_keep], dtype=out_dtype)
+    return np.ascontiguousarray(P[: li.n_keep], dtype=out_dtype)
 
 
-def _one_side_sectors(level: Level, sec) -> np.ndarray:
-    """(n,) the sector that gives a vertex with several sectors its one side; -1 where no face is.
-
-    OpenSubdiv's rule (Sdc's crease limit tangent masks take the span counter-clockwise from
-    the first crease edge in the vertex's edge order, which starts at the outgoing edge of its
-    first face): the sector of the vertex's first face corner (in face order) if that corner's
-    outgoing edge starts the sector, else the next sector counter-clockwise.
-    """
-    n = level.n_vertices
-    out = np.full(n, -1, dtype=np.int64)
-    corners = level.faces.ravel()
-    first = np.full(n, len(corners), dtype=np.int64)
-    np.minimum.at(first, corners, np.arange(len(corners)))
-    v = np.flatnonzero(first < len(corners))
-    h0 = first[v]
-    s0 = sec.he_sector[h0]
-    at_start = (sec.slots[sec.slot_start[:-1][s0]] == h0) | ~sec.open[s0]
-    key = sec.vertex * np.int64(n) + sec.first_ring  # the sector of a vertex that starts at q
-    order = np.argsort(key, kind="stable")
-    want = sec.vertex[s0] * np.int64(n) + sec.last_ring[s0]  # the next one starts where s0 ends
-    i = np.minimum(np.searchsorted(key[order], want), len(order) - 1)
-    found = key[order[i]] == want
-    out[v] = np.where(at_start | ~found, s0, order[i])
-    return out
+def _level_limits(li: LimitInput, Vf: np.ndarray, loop_weights: str, want_positions: bool, want_normals: bool,
+                  crease_normals: str, tol: float, normal_tol: float, max_levels: int):
+    """Limit positions and unit normals (each or None, as wanted) of every vertex of the level
+    evaluated (the vertex lane)."""
+    X = li.X if li.X is not None else li.refinement.apply(Vf)
+    if len(li.faces) == 0:
+        return X, np.zeros_like(X)
+    return level_limits(li, X, loop_weights, want_positions, want_normals, crease_normals, tol, normal_tol, max_levels)
 
 
 CREASE_NORMALS = ("average", "one_side")
@@ -331,7 +186,7 @@ def _sector_evaluation(V, F, sharp_edges, levels, scheme, sharpness, sharp_faces
     if s.level is None:
         return s, F_out, keep, None
     X = r.apply(Vf)
-    _, plan, nrm = _evaluate(s, scheme, loop_weights, X, False, tol, max_levels)
+    _, plan, nrm = evaluate_level(s, scheme, loop_weights, X, False, tol, max_levels)
     return s, F_out, keep, (X, plan, nrm)
 
 
@@ -389,25 +244,96 @@ def limit_normals(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = No
     >>> np.allclose(N, V / np.sqrt(3))                 # outward, by symmetry
     True
     """
-    if not isinstance(crease_normals, str) or crease_normals not in CREASE_NORMALS:
-        raise ValueError(f"crease_normals must be one of {CREASE_NORMALS}, got {crease_normals!r}")
+    _check_crease_normals(crease_normals)
+    if not per_face_corner:
+        Vf = as_vertices(np.asarray(V))
+        tol, max_levels = _check_tol(tol, max_levels)
+        li = walk_for_limit(Vf, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
+                            feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
+                            holes=holes)
+        _, N = _level_limits(li, Vf, loop_weights, False, True, crease_normals, tol, tol, max_levels)
+        return N[: li.n_keep]
     s, F_out, keep, ev = _sector_evaluation(V, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners,
                                             loop_weights, feature_angle, tol, max_levels, corner_sharpness, boundary,
                                             holes)
     if ev is None:
-        N = np.zeros((s.n_keep, 3))
-        return np.zeros((len(F_out), 3, 3))[keep] if per_face_corner else N
+        return np.zeros((len(F_out), 3, 3))[keep]
     X, plan, nrm = ev
-    N = _vertex_normals(s.level, plan, nrm, X)
-    if per_face_corner:
-        if s.same_level:
-            return nrm[plan.sectors.he_sector].reshape(-1, 3, 3)[keep]
-        return N[F_out][keep]
-    if crease_normals == "one_side":
-        first = _one_side_sectors(s.level, plan.sectors)
-        used = first >= 0
-        N[used] = nrm[first[used]]
-    return N[: s.n_keep]
+    if s.same_level:
+        return nrm[plan.sectors.he_sector].reshape(-1, 3, 3)[keep]
+    return vertex_normals(s.level, plan, nrm, X)[F_out][keep]
+
+
+class LimitMesh(NamedTuple):
+    """A mesh refined and put on its limit surface (:func:`limit_mesh`)."""
+
+    vertices: np.ndarray  #: (n_L, 3) limit positions of the level's vertices
+    faces: np.ndarray  #: (m_L, 3) the level's faces (those of holes left out)
+    normals: np.ndarray | None  #: (n_L, 3) unit limit normals, or None
+
+
+def limit_mesh(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: int = 1,
+               scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
+               corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+               feature_angle: float | None = None, normals: bool = True, crease_normals: str = "average",
+               tol: float = 1e-12, normal_tol: float = 1e-10, max_levels: int = 60,
+               corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+               holes: ArrayLike | None = None) -> LimitMesh:
+    """A mesh refined ``levels`` times with its vertices on the limit surface, and their normals.
+
+    One refinement and one pass over the vertices give what :func:`hybridsub.refine`,
+    :func:`limit_positions` and :func:`limit_normals` give separately (the same numbers):
+    what a renderer or an exporter wants from a subdivision surface, as OpenSubdiv's limit
+    stencils or Adobe Lagrange's ``subdivide_mesh(use_limit_surface=True)`` give it.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles, consistently oriented, every edge in one or two faces.
+    sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights, feature_angle, corner_sharpness, boundary, holes
+        As for :func:`limit_positions` (holes: their faces are left out of ``faces``).
+    normals : bool
+        Also give the unit limit normals (False: ``normals`` is None).
+    crease_normals : {"average", "one_side"}
+        As for :func:`limit_normals`.
+    tol, max_levels
+        As for :func:`limit_positions`.
+    normal_tol
+        As ``tol`` of :func:`limit_normals`.
+
+    Returns
+    -------
+    LimitMesh
+        ``(vertices, faces, normals)``.
+
+    Examples
+    --------
+    >>> import numpy as np, hybridsub
+    >>> V, F = hybridsub.load_example("fandisk")
+    >>> m = hybridsub.limit_mesh(V, F, levels=2, scheme="loop", feature_angle=30)
+    >>> m.vertices.shape == m.normals.shape, len(m.faces) == 16 * len(F)
+    (True, True)
+    >>> bool(np.allclose(m.vertices, hybridsub.limit_positions(V, F, levels=2, scheme="loop", feature_angle=30)))
+    True
+    """
+    _check_crease_normals(crease_normals)
+    A = np.asarray(V)
+    Vf = as_vertices(A)
+    tol, max_levels = _check_tol(tol, max_levels)
+    normal_tol, _ = _check_tol(normal_tol, max_levels)
+    li = walk_for_limit(Vf, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
+                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+    P, N = _level_limits(li, Vf, loop_weights, True, bool(normals), crease_normals, tol, normal_tol, max_levels)
+    out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
+    return LimitMesh(np.ascontiguousarray(P[: li.n_keep], dtype=out_dtype), li.out_faces,
+                     N[: li.n_keep] if normals else None)
+
+
+def _check_crease_normals(crease_normals):
+    if not isinstance(crease_normals, str) or crease_normals not in CREASE_NORMALS:
+        raise ValueError(f"crease_normals must be one of {CREASE_NORMALS}, got {crease_normals!r}")
 
 
 def _sector_tangents(level: Level, plan, nrm: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -497,7 +423,7 @@ def limit_tangents(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = N
     if per_face_corner and s.same_level:
         h = plan.sectors.he_sector
         return t1[h].reshape(-1, 3, 3)[keep], t2[h].reshape(-1, 3, 3)[keep]
-    first = _one_side_sectors(s.level, plan.sectors)
+    first = one_side_sectors(s.level, plan.sectors)
     used = first >= 0
     T1, T2 = np.zeros((s.level.n_vertices, 3)), np.zeros((s.level.n_vertices, 3))
     T1[used], T2[used] = t1[first[used]], t2[first[used]]

@@ -1,0 +1,111 @@
+"""The vertex lane: limit positions and normals of a whole level without a plan of every
+vertex.
+
+Almost every vertex of a refined level is smooth: one closed fan of faces of one kind, no
+tag. Those get their limit position and normal from their ring in one kernel pass
+(``_vertex_kernels``), with the weights of the scheme's rules (``_rules.limit``) tabulated by
+valence. The rest — creases, corners, boundaries, darts, vertices between √3 and Loop faces —
+go through the general evaluation (``level_eval``: the plan, its masks, local refinement
+where a vertex has none) on just the faces around them, which is all their masks and local
+refinement read.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from .._rules import limit as LR
+from .._rules import step_rules as R
+from . import _vertex_kernels as VK
+from .limit_setup import LimitInput, local_setup
+from .level_eval import evaluate_level
+from .mask_plan import plan_level
+from .normals import one_side_sectors, sector_normals, vertex_normals
+
+#: Valences the kernel's tables cover; a vertex of higher valence takes the general plan.
+MAX_LANE_VALENCE = 64
+
+
+@functools.lru_cache(maxsize=None)
+def _tables(loop_weights: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The smooth limit weight per (region, valence) and the tangent weights per (valence, j)."""
+    k = np.arange(MAX_LANE_VALENCE)
+    w = np.stack([LR.smooth_limit_weight(k, np.full(len(k), R.REGION_SQRT3), loop_weights),
+                  LR.smooth_limit_weight(k, np.full(len(k), R.REGION_LOOP), loop_weights)])
+    kk, jj = np.meshgrid(np.maximum(k, 1), k, indexing="ij")
+    c, s = LR.smooth_tangent_weights(kk, jj)
+    for a in (w, c, s):
+        a.flags.writeable = False
+    return w, np.ascontiguousarray(c), np.ascontiguousarray(s)
+
+
+def _corner_slots(F: np.ndarray, n: int):
+    """:func:`_vertex_kernels.corner_slots` into int32 arrays where the ids fit (half the
+    memory to write and read), else int64."""
+    dtype = np.int32 if max(n, len(F)) < 2**31 else np.int64
+    A, B, face = (np.empty(3 * len(F), dtype) for _ in range(3))
+    return VK.corner_slots(F, n, A, B, face), A, B, face
+
+
+def _blocked(li: LimitInput) -> np.ndarray:
+    """(n,) vertices the smooth rule cannot take for their tags: an end of a tagged edge, or a
+    tagged corner ("sqrt3" ignores both: only its boundary is sharp)."""
+    blocked = np.zeros(li.n_vertices, dtype=bool)
+    if li.scheme == "sqrt3":
+        return blocked
+    pairs, sharpness = li.tag_pairs()
+    blocked[pairs[sharpness > 0].ravel()] = True
+    return blocked | li.corner
+
+
+def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_positions: bool, want_normals: bool,
+                 crease_normals: str, tol: float, normal_tol: float, max_levels: int):
+    """Limit positions and unit normals (each None unless wanted) of every vertex of the level
+    evaluated, from its positions ``X`` (n, 3).
+
+    The normal of a vertex with several sectors is the normalized mean of theirs, or
+    (``crease_normals="one_side"``) OpenSubdiv's side, as :func:`hybridsub.limit_normals`;
+    ``tol``, ``normal_tol`` and ``max_levels`` bound the local refinement of the vertices
+    without stationary masks, as there.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hybridsub._surface.limit_setup import walk_for_limit
+    >>> V = np.array([[1., 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    >>> li = walk_for_limit(V, F, [[0, 1]], 1, "hybrid", None, None, None, "loop")
+    >>> P, N = level_limits(li, li.X, "loop", True, True, "average", 1e-12, 1e-10, 60)
+    >>> P.shape, bool(np.allclose(np.linalg.norm(N, axis=1), 1))
+    ((9, 3), True)
+    """
+    F = li.faces
+    n = li.n_vertices
+    X = np.ascontiguousarray(X, dtype=np.float64)
+    start, A, B, face = _corner_slots(F, n)
+    w, c, s = _tables(loop_weights)
+    P, N, done = VK.smooth_vertex_limits(start, A, B, face, X, _blocked(li), li.face_sharp.view(np.uint8), w, c, s,
+                                         want_normals)
+    G = np.flatnonzero(~done)
+    if len(G):
+        sub, used = local_setup(li, VK.faces_around(start, face, G, len(F)), np.diff(start))
+        Xs = X[used]
+        g = np.searchsorted(used, G)
+        at_g = np.zeros(len(used), dtype=bool)
+        at_g[g] = True
+        plan = plan_level(sub.level, sub.esharp, sub.face_sharp, sub.corner, li.scheme, loop_weights)
+        if want_positions:
+            L, _, _ = evaluate_level(sub, li.scheme, loop_weights, None, True, tol, max_levels, only=at_g, plan=plan)
+            P[G] = L[g] @ Xs
+        if want_normals:
+            _, _, nrm = evaluate_level(sub, li.scheme, loop_weights, Xs, False, normal_tol, max_levels, only=at_g,
+                                       plan=plan)
+            Ns = vertex_normals(sub.level, plan, nrm, Xs)
+            if crease_normals == "one_side":
+                first = one_side_sectors(sub.level, plan.sectors)
+                used_s = first >= 0
+                Ns[used_s] = nrm[first[used_s]]
+            N[G] = Ns[g]
+    return (P if want_positions else None), (N if want_normals else None)
