@@ -9,7 +9,10 @@ does not go through the lane's kernel. ``limit_mesh`` itself must give what ``re
 
 import numpy as np
 import pytest
+import strategies as ms
 from conftest import load_mesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import hybridsub
 from hybridsub._surface.level_eval import evaluate_level
@@ -124,3 +127,20 @@ def test_limit_mesh_bad_input():
     V0, F0 = V.copy(), F.copy()
     hybridsub.limit_mesh(V, F, [[0, 1]], levels=2)
     assert np.array_equal(V, V0) and np.array_equal(F, F0)
+
+
+@settings(max_examples=25, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much])
+@given(st.data(), st.sampled_from(["hybrid", "sqrt3", "loop"]), st.sampled_from([0, 1, 2]))
+def test_lane_on_generated_tagged_meshes(data, scheme, levels):
+    # Creases, semi-sharp creases, sharp faces, corners, boundaries, several pieces, high
+    # valences and vertices two fans share (bowties).
+    V, F, tags = data.draw(ms.tagged_meshes(bowties=True))
+    if scheme == "sqrt3":
+        tags = {}
+    elif scheme == "loop":
+        tags.pop("sharp_faces", None)
+    li = walk_for_limit(V, F, tags.get("sharp_edges"), levels, scheme, tags.get("sharpness"), tags.get("sharp_faces"),
+                        tags.get("corners"), "loop")
+    if len(li.faces):
+        _agree(li, V, data.draw(st.sampled_from(["average", "one_side"])))
