@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import kernel
+from numba import prange
+
+from .._jit import kernel, threaded_and_serial
 
 
 @kernel
@@ -43,8 +45,7 @@ def corner_slots(F, n, A, B, face):
     return start
 
 
-@kernel
-def smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, cos_table, sin_table, want_normals):
+def _smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, cos_table, sin_table, want_normals):
     """Limit position and unit normal of every vertex whose ring is one closed fan of faces of
     one kind (all √3 or all Loop), with no tag (``blocked`` False).
 
@@ -55,14 +56,15 @@ def smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, cos
     Returns ``(P, N, done)``: ``done`` False where the vertex is left to the general path
     (tagged, mixed faces, a boundary or a second fan, valence ≥ the tables' size, a
     degenerate tangent pair); P and N are not written there. A vertex no face uses is done:
-    its own position, a zero normal.
+    its own position, a zero normal. Threaded over the vertices (``smooth_vertex_limits``;
+    ``smooth_vertex_limits_serial`` the same on one thread: each vertex is its own sums).
     """
     n = start.shape[0] - 1
     kmax = cos_table.shape[0]
     P = np.empty((n, 3))
     N = np.zeros((n, 3))
     done = np.zeros(n, np.bool_)
-    for v in range(n):
+    for v in prange(n):
         lo = start[v]
         k = start[v + 1] - lo
         if k == 0:
@@ -129,6 +131,9 @@ def smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, cos
         P[v, 2] = c0 * X[v, 2] + w * sz
         done[v] = True
     return P, N, done
+
+
+smooth_vertex_limits, smooth_vertex_limits_serial = threaded_and_serial(_smooth_vertex_limits)
 
 
 @kernel

@@ -18,6 +18,7 @@ import numpy as np
 
 from .._rules import limit as LR
 from .._rules import step_rules as R
+from .._topology._kernels import use_threads
 from . import _vertex_kernels as VK
 from .limit_setup import LimitInput, local_setup
 from .level_eval import evaluate_level
@@ -86,7 +87,8 @@ def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_position
     X = np.ascontiguousarray(X, dtype=np.float64)
     start, A, B, face = _corner_slots(F, n)
     w, c, s = _tables(loop_weights)
-    P, N, done = VK.smooth_vertex_limits(start, A, B, face, X, _blocked(li), li.face_sharp.view(np.uint8), w, c, s,
+    lane = VK.smooth_vertex_limits if use_threads(n) else VK.smooth_vertex_limits_serial
+    P, N, done = lane(start, A, B, face, X, _blocked(li), li.face_sharp.view(np.uint8), w, c, s,
                                          want_normals)
     G = np.flatnonzero(~done)
     if len(G):
