@@ -15,9 +15,9 @@ from .._topology import Level, build_level
 from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
 from .._refiner import refinement_of
 from .._refiner.refinement import level_holes
-from .local import refine_locally
+from .local import plan_vertices, refine_locally
 from .normals import sector_normals, unit
-from .mask_plan import SEC_FAN, SEC_TRANSIENT, edge_sharpness, plan_level
+from .mask_plan import SEC_FAN, SEC_TRANSIENT, edge_sharpness
 
 # ---------------------------------------------------------------------------------------------
 # Input preparation: the mesh refined to the level evaluated, its tags per edge, face, vertex
@@ -32,7 +32,7 @@ class LimitSetup:
     tagged: np.ndarray
     esharp: np.ndarray
     face_sharp: np.ndarray
-    corner: np.ndarray
+    corner: np.ndarray  # (n,) bool, or with local_corners each vertex's sharpness left (float64)
     refinement: object  # the Refinement to the evaluated level
     n_keep: int  # vertices of the requested level
     same_level: bool  # evaluated at the requested level (else one finer: Kobbelt's parity)
@@ -47,12 +47,15 @@ class LimitSetup:
 
 def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
                 positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only",
-                holes=None) -> LimitSetup:
+                holes=None, local_corners=False) -> LimitSetup:
     """Check the input and refine it to the level evaluated (see :class:`LimitSetup`).
 
-    A semi-sharp corner is refined uniformly until its sharpness is spent (⌈s⌉ levels): the
-    masks of the level evaluated then see no finite vertex sharpness, so its limit is that of
-    uniform refinement (the old vertices keep their indices, hence the first ``n_keep``).
+    With ``local_corners`` (limit positions and matrices) a semi-sharp corner keeps its
+    sharpness left at the level evaluated (``corner`` is then vertex sharpness): its star
+    alone is refined until the sharpness is spent (:func:`.local.refine_locally`). Without
+    (normals, tangents) the whole mesh is refined uniformly until every sharpness is spent
+    (⌈s⌉ levels), so the masks of the level evaluated see none (the old vertices keep their
+    indices, hence the first ``n_keep``).
 
     >>> import numpy as np
     >>> s = setup_limit(np.array([[0, 1, 2]]), None, 1, None, "sqrt3", None, None, None, "loop")
@@ -64,7 +67,7 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
                     feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     levels, n = inp.levels, inp.n_vertices
     l_eval = levels
-    if inp.corner_sharpness is not None:
+    if inp.corner_sharpness is not None and not local_corners:
         finite = inp.corner_sharpness[np.isfinite(inp.corner_sharpness)]
         l_eval = max(levels, int(np.ceil(finite.max(initial=0.0))))
     # Kobbelt's boundary rule alternates: evaluate where the next step is odd.
@@ -84,6 +87,10 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
         face_sharp[:] = True
     corner = np.zeros(n_eval, dtype=bool)
     corner[np.asarray(r.corners, dtype=np.int64)] = True
+    if local_corners and inp.corner_sharpness is not None:
+        corner = np.zeros(n_eval)
+        left = r.corner_sharpness
+        corner[np.asarray(r.corners, dtype=np.int64)] = np.inf if left is None else left
     if m == 0:
         return LimitSetup(None, None, None, face_sharp, corner, r, n_keep, l_eval == levels, inp.hole)
     level = build_level(faces, n_eval)
@@ -110,7 +117,7 @@ def _evaluate(s: LimitSetup, scheme, loop_weights, X, want_rows, tol, max_levels
     """Limit matrix (n × n CSR, or None), plan and sector normals (or None) of the level evaluated."""
     level = s.level
     n = level.n_vertices
-    plan = plan_level(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
+    plan = plan_vertices(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
     nrm = sector_normals(level, plan, X) if X is not None else None
     need = np.zeros(n, dtype=bool)
     if want_rows:
@@ -182,7 +189,7 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         The subdivision scheme whose limit is meant.
     sharpness, sharp_faces, corners, corner_sharpness, boundary, loop_weights
         As for :func:`hybridsub.refine` (a semi-sharp corner's limit is that of uniform
-        refinement: the level evaluated is refined until its sharpness is spent).
+        refinement until its sharpness is spent: its star alone is refined so far).
     feature_angle : float, optional
         Also keep sharp the edges whose dihedral angle exceeds this many degrees, with their
         corners, as for :func:`hybridsub.limit_positions`; the angles are measured on
@@ -226,7 +233,7 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         n_vertices = len(Vf)
     s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
                     positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
+                    holes=holes, local_corners=True)
     r = s.refinement
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
@@ -277,7 +284,7 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     tol, max_levels = _check_tol(tol, max_levels)
     s = setup_limit(F, sharp_edges, levels, len(Vf), scheme, sharpness, sharp_faces, corners, loop_weights,
                     positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
+                    holes=holes, local_corners=True)
     X = s.refinement.apply(Vf)
     if s.level is not None:
         L, _, _ = _evaluate(s, scheme, loop_weights, None, True, tol, max_levels)

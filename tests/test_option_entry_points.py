@@ -1,0 +1,59 @@
+"""The newer options (corner_sharpness=, boundary=, holes=) at every entry point that refines:
+each against an independent computation of the same thing (the whole mesh refined until the
+corners' sharpness is spent, subdivide for subdivide_mesh, limit_positions for LimitSurface)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import hybridsub
+
+DATA = Path(__file__).parent / "data"
+
+
+def _mesh(name):
+    m = hybridsub.read_mesh(DATA / name)
+    return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+
+
+def _corner_case(scheme="loop"):
+    """cube-meshed's eight corners (Loop); for the hybrid, whose mixed vertices are refined
+    locally at every level of the whole-mesh oracle, the octahedron, every vertex a corner."""
+    if scheme == "loop":
+        V, F = _mesh("cube-meshed.off")
+        c = np.flatnonzero((np.abs(V) > 0.999).sum(axis=1) == 3)
+    else:
+        V, F = _mesh("octahedron.off")
+        c = np.arange(len(V))
+    return V, F, c, np.resize([0.5, 1.0, 2.5, 3.2], len(c))
+
+
+def _whole_mesh_limit(V, F, levels, scheme, sharp_faces, c, s):
+    """The limit of the level-``levels`` vertices by refining the whole mesh until every
+    sharpness is spent (⌈max s⌉ levels, at least ``levels``), then taking the limit masks of
+    that level, where the corners left are infinitely sharp."""
+    k = max(levels, int(np.ceil(s.max())))
+    r = hybridsub.refine(F, levels=k, scheme=scheme, sharp_faces=sharp_faces, corners=c, corner_sharpness=s)
+    n_keep = r.steps[levels - 1].n_vertices if levels else len(V)
+    P = hybridsub.limit_positions(r.apply(V), r.faces, r.sharp_edges, sharpness=r.sharpness, scheme=scheme,
+                                  sharp_faces=r.sharp_faces, corners=r.corners)
+    return P[:n_keep]
+
+
+@pytest.mark.parametrize("scheme,levels", [("loop", 0), ("loop", 1), ("hybrid", 0), ("hybrid", 2)])
+def test_semi_sharp_corner_limit_is_local(scheme, levels):
+    """limit_positions and limit_matrix refine only the semi-sharp corners' stars: the same
+    limit as refining the whole mesh first, to 1e-12 × the diagonal."""
+    V, F, c, s = _corner_case(scheme)
+    sf = np.arange(0, len(F), 3) if scheme == "hybrid" else None
+    kw = dict(levels=levels, scheme=scheme, sharp_faces=sf, corners=c, corner_sharpness=s)
+    P = hybridsub.limit_positions(V, F, **kw)
+    want = _whole_mesh_limit(V, F, levels, scheme, sf, c, s)
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    assert P.shape == want.shape
+    assert np.abs(P - want).max() < 1e-12 * diag
+    M = hybridsub.limit_matrix(F, **kw)
+    assert np.abs(M @ V - want).max() < 1e-12 * diag
