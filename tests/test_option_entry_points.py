@@ -57,3 +57,37 @@ def test_semi_sharp_corner_limit_is_local(scheme, levels):
     assert np.abs(P - want).max() < 1e-12 * diag
     M = hybridsub.limit_matrix(F, **kw)
     assert np.abs(M @ V - want).max() < 1e-12 * diag
+
+
+def _surface_case(scheme):
+    """An open mesh (a boundary for boundary=), a semi-sharp crease, semi-sharp corners."""
+    V, F = _mesh("mesh_with_border.off")
+    c = np.array([0, 5, 17])
+    s = np.array([0.5, 1.5, 2.7])
+    kw = dict(scheme=scheme, corners=c, corner_sharpness=s, boundary="edge_and_corner",
+              sharp_edges=F[[100, 300], :2], sharpness=[1.5, 0.6])
+    if scheme == "hybrid":
+        kw["sharp_faces"] = np.arange(0, len(F), 4)
+    return V, F, kw
+
+
+@pytest.mark.parametrize("scheme", ["loop", "hybrid"])
+def test_limit_surface_takes_the_options(scheme):
+    """LimitSurface(...) at the vertices of a refined level (refine's vertex_origin) equals
+    limit_positions(levels=L) with the same options, to 1e-12 × the diagonal."""
+    V, F, kw = _surface_case(scheme)
+    L = 2
+    r = hybridsub.refine(F, levels=L, n_vertices=len(V), **kw)
+    face, bary = r.vertex_origin
+    P = hybridsub.limit_positions(V, F, levels=L, **kw)
+    # the points on the faces at the tagged corners and creases, and every 7th of the others
+    near = np.isin(F, np.concatenate([kw["corners"], np.ravel(kw["sharp_edges"])])).any(axis=1)
+    used = (face >= 0) & (near[np.maximum(face, 0)] | (np.arange(len(face)) % 7 == 0))
+    surf = hybridsub.LimitSurface(V, F, **kw)
+    Q = surf.evaluate(face[used], bary[used])
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    assert np.abs(Q - P[used]).max() < 1e-12 * diag
+    # and the options make a difference there
+    at = np.asarray(kw["corners"])  # old vertices keep their indices
+    plain = hybridsub.LimitSurface(V, F, scheme=scheme, sharp_faces=kw.get("sharp_faces")).evaluate(face[at], bary[at])
+    assert np.abs(plain - P[at]).max() > 1e-3 * diag
