@@ -91,3 +91,48 @@ def test_limit_surface_takes_the_options(scheme):
     at = np.asarray(kw["corners"])  # old vertices keep their indices
     plain = hybridsub.LimitSurface(V, F, scheme=scheme, sharp_faces=kw.get("sharp_faces")).evaluate(face[at], bary[at])
     assert np.abs(plain - P[at]).max() > 1e-3 * diag
+
+
+def test_subdivide_mesh_takes_the_options():
+    """subdivide_mesh(trimesh, ...) equals subdivide(V, F, ...) with corner_sharpness,
+    boundary and holes; its result, subdivided again from its metadata, equals two levels."""
+    trimesh = pytest.importorskip("trimesh")
+    V, F, kw = _surface_case("loop")
+    kw.pop("scheme")
+    holes = np.arange(0, len(F), 50)
+    opts = dict(kw, holes=holes)
+    mesh = trimesh.Trimesh(V, F, process=False)
+    fine = hybridsub.subdivide_mesh(mesh, levels=1, scheme="loop", weld=False, **opts)
+    V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", **opts)
+    assert np.array_equal(fine.faces, F1) and np.array_equal(fine.vertices, V1)
+    meta = fine.metadata["hybridsub"]
+    assert len(meta["corner_sharpness"]) == len(meta["corners"]) and np.isinf(meta["corner_sharpness"]).any()
+    # again from the metadata (tags, the corners' sharpness left; the holes' faces are gone)
+    again = hybridsub.subdivide_mesh(trimesh.Trimesh(V1, F1, process=False, metadata=fine.metadata), levels=1,
+                                     scheme="loop", weld=False)
+    r = hybridsub.refine(F, levels=1, n_vertices=len(V), scheme="loop", **opts)
+    V2, F2 = hybridsub.subdivide(V1, F1, levels=1, scheme="loop", sharp_edges=r.sharp_edges,
+                                 sharpness=r.sharpness, corners=r.corners, corner_sharpness=r.corner_sharpness)
+    assert np.array_equal(again.faces, F2) and np.allclose(again.vertices, V2, rtol=0, atol=1e-13 * np.abs(V).max())
+
+
+def test_face_varying_functions_take_the_options():
+    """subdivide_face_varying and refine_face_varying with corner_sharpness, boundary and
+    holes: the geometry is subdivide's (Loop), the UV faces stay aligned with the faces."""
+    V, F, kw = _surface_case("loop")
+    FUV = F.copy()  # no seams: the UVs are per vertex
+    UV = V[:, :2].copy()
+    holes = np.arange(0, len(F), 50)
+    opts = dict(kw, holes=holes)
+    V2, F2, UV2, FUV2 = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, **opts)
+    W2, G2 = hybridsub.subdivide(V, F, levels=2, **opts)
+    assert np.array_equal(F2, G2) and np.allclose(V2, W2, rtol=0, atol=1e-13 * np.abs(V).max())
+    assert FUV2.shape == F2.shape
+    geo, uv = hybridsub.refine_face_varying(F, FUV, levels=2, uv_interpolation="none", **opts)
+    assert np.array_equal(geo.faces, F2) and np.array_equal(uv.faces, FUV2)
+    X, G, UVm, FUVm, S, Suv = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, return_matrix=True, **opts)
+    assert np.allclose(S @ V, V2, rtol=0, atol=1e-13 * np.abs(V).max()) and np.array_equal(FUVm, FUV2)
+    # without holes the fast path runs: the same numbers
+    opts.pop("holes")
+    V3, F3, _, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, **opts)
+    assert np.allclose(V3, hybridsub.subdivide(V, F, levels=2, **opts)[0], rtol=0, atol=1e-13 * np.abs(V).max())
