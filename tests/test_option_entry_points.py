@@ -136,3 +136,31 @@ def test_face_varying_functions_take_the_options():
     opts.pop("holes")
     V3, F3, _, _ = hybridsub.subdivide_face_varying(V, F, UV, FUV, levels=2, **opts)
     assert np.allclose(V3, hybridsub.subdivide(V, F, levels=2, **opts)[0], rtol=0, atol=1e-13 * np.abs(V).max())
+
+
+def test_command_line_boundary_in_subdivide_and_batch(tmp_path):
+    """``hybridsub subdivide --boundary none`` leaves out the faces at the boundary, as
+    subdivide(boundary="none"); a batch's task with ``boundary`` writes the same bytes (and a
+    default batch's options, hence its manifest key, are unchanged)."""
+    from hybridsub._app import batch as _batch
+    from hybridsub._app.cli import main
+    from hybridsub._app.pipeline import subdivide_file
+    from hybridsub._app.task import file_options
+
+    src = str(DATA / "mesh_with_border.off")
+    out = tmp_path / "cli.obj"
+    assert main(["subdivide", src, "-o", str(out), "--levels", "1", "--scheme", "loop", "--boundary", "none",
+                 "-q"]) == 0
+    V, F = _mesh("mesh_with_border.off")
+    V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", boundary="none")
+    m = hybridsub.read_mesh(out)
+    assert np.array_equal(m.faces, F1) and np.allclose(m.vertices, V1, rtol=0, atol=1e-9 * np.abs(V).max())
+    args = (1, "loop", None, None, "loop", "obj", False, False, False, None)
+    assert "boundary" not in _batch.batch_options(*args)
+    options = _batch.batch_options(*args, boundary="none")
+    assert options["boundary"] == "none"
+    task_out = tmp_path / "task.obj"
+    subdivide_file(file_options(options), src, str(task_out))
+    assert task_out.read_bytes() == out.read_bytes()
+    with pytest.raises(ValueError, match="boundary must be one of"):
+        _batch.batch_options(*args, boundary="edges")
