@@ -164,3 +164,15 @@ def test_command_line_boundary_in_subdivide_and_batch(tmp_path):
     assert task_out.read_bytes() == out.read_bytes()
     with pytest.raises(ValueError, match="boundary must be one of"):
         _batch.batch_options(*args, boundary="edges")
+
+
+def test_limit_surface_projects_with_semi_sharp_corners():
+    """project() on a surface with semi-sharp corners: the limit points of its corners project
+    onto themselves (the seeds' limit points take the sharpness left, as evaluate does)."""
+    V, F, kw = _surface_case("loop")
+    surf = hybridsub.LimitSurface(V, F, **kw)
+    P = hybridsub.limit_positions(V, F, **kw)[kw["corners"]]
+    face, bary, Q, dist = surf.project(P)
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    assert np.abs(Q - P).max() < 1e-10 * diag and np.abs(dist).max() < 1e-10 * diag
+    assert np.abs(surf.evaluate(face, bary) - P).max() < 1e-10 * diag
