@@ -176,3 +176,20 @@ def test_limit_surface_projects_with_semi_sharp_corners():
     diag = np.linalg.norm(np.ptp(V, axis=0))
     assert np.abs(Q - P).max() < 1e-10 * diag and np.abs(dist).max() < 1e-10 * diag
     assert np.abs(surf.evaluate(face, bary) - P).max() < 1e-10 * diag
+
+
+@pytest.mark.parametrize("levels", [3, None])
+def test_fit_takes_semi_sharp_corners(levels):
+    """fit(corner_sharpness=) recovers the control positions of a surface (refined, or the
+    limit) with semi-sharp corners from its own points; without the sharpness it cannot."""
+    V, F, c, s = _corner_case("hybrid")  # the octahedron, every vertex a corner
+    kw = dict(scheme="loop", corners=c, corner_sharpness=s)
+    W = V * [1.0, 1.3, 0.8]
+    if levels is None:
+        target = hybridsub.limit_positions(W, F, levels=2, **kw)
+    else:
+        target = hybridsub.subdivide(W, F, levels=levels, **kw)[0]
+    res = hybridsub.fit(F, target, V0=V, levels=levels, max_iterations=30, **kw)
+    assert np.abs(res.vertices - W).max() < 1e-9
+    wrong = hybridsub.fit(F, target, V0=V, levels=levels, max_iterations=30, scheme="loop", corners=c)
+    assert np.abs(wrong.vertices - W).max() > 1e-3
