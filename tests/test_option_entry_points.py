@@ -193,3 +193,14 @@ def test_fit_takes_semi_sharp_corners(levels):
     assert np.abs(res.vertices - W).max() < 1e-9
     wrong = hybridsub.fit(F, target, V0=V, levels=levels, max_iterations=30, scheme="loop", corners=c)
     assert np.abs(wrong.vertices - W).max() > 1e-3
+
+
+def test_subdivide_mesh_pyvista_takes_the_options():
+    pv = pytest.importorskip("pyvista")
+    V, F, kw = _surface_case("loop")
+    kw.pop("scheme")
+    poly = pv.PolyData(V, np.hstack([np.full((len(F), 1), 3), F]).ravel())
+    fine = hybridsub.subdivide_mesh(poly, levels=1, scheme="loop", weld=False, holes=[0, 9], **kw)
+    V1, F1 = hybridsub.subdivide(V, F, levels=1, scheme="loop", holes=[0, 9], **kw)
+    assert np.array_equal(np.asarray(fine.regular_faces), F1) and np.array_equal(np.asarray(fine.points), V1)
+    assert len(fine.field_data["corner_sharpness"]) == len(fine.field_data["corners"])
