@@ -159,6 +159,6 @@ def test_figure_script_runs(tmp_path):
     mod.main(["--out", str(tmp_path), "--quick"])
     made = sorted(p.name for p in tmp_path.iterdir())
     assert made == ["adaptive_fandisk.png", "analysis_charmaps.png", "analysis_spectra.png", "features_fandisk.png",
-                    "limit_convergence.png", "limit_fandisk.png", "limit_octahedron.png",
+                    "limit_convergence.png", "limit_fandisk.png", "limit_octahedron.png", "options_cube.png",
                     "semisharp_cube.png", "textured_bunny.png"]
     assert all((tmp_path / m).stat().st_size > 5000 for m in made)

@@ -2,8 +2,8 @@
 against OpenSubdiv's own results.
 
 References: tests/data/fvar/ (``benchmarks/peers/build.sh && python tests/data/fvar/generate.py``),
-the textured bunny scan, Loop, levels 1 and 2, compared per face corner as in
-test_face_varying.py.
+the part of the textured bunny scan around its three alternating vertices (generate.py), Loop,
+levels 1 and 2, compared per face corner as in test_face_varying.py.
 """
 
 import os
@@ -25,10 +25,10 @@ KNOWN = {("none", 1): 11, ("none", 2): 209, ("corners_only", 1): 7, ("corners_on
 @pytest.mark.parametrize("levels", [1, 2])
 @pytest.mark.parametrize("mode", MODES)
 def test_modes_match_opensubdiv(mode, levels):
-    d = np.load(os.path.join(DATA, "bunny10k_textured.input.npz"))
-    g = np.load(os.path.join(DATA, f"bunny10k_textured.L{levels}.npz"))
+    d = np.load(os.path.join(DATA, "bunny_seams.input.npz"))
+    g = np.load(os.path.join(DATA, f"bunny_seams.L{levels}.npz"))
     ref = dict(V=g["V"], F=g["F"], FUV=g["FUV"],
-               UV=np.load(os.path.join(DATA, f"bunny10k_textured.{mode}.L{levels}.npz"))["UV"])
+               UV=np.load(os.path.join(DATA, f"bunny_seams.{mode}.L{levels}.npz"))["UV"])
     V, F, UV, FUV = hybridsub.subdivide_face_varying(d["V_in"], d["F_in"], d["UV_in"], d["FUV_in"], levels=levels,
                                                      scheme="loop", uv_interpolation=mode)
     assert mesh_difference(V, F, ref["V"], ref["F"], 1e-12) is None

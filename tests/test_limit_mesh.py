@@ -144,3 +144,20 @@ def test_lane_on_generated_tagged_meshes(data, scheme, levels):
                         tags.get("corners"), "loop")
     if len(li.faces):
         _agree(li, V, data.draw(st.sampled_from(["average", "one_side"])))
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_limit_mesh_with_semi_sharp_corners(scheme):
+    # Positions alone refine the semi-sharp corners' stars; with normals the whole mesh is
+    # refined until their sharpness is spent: the same limit either way.
+    V, F = _load("fandisk")
+    fe = hybridsub.detect_features(V, F, 30)
+    kw = dict(scheme=scheme, sharp_edges=fe.sharp_edges, corners=fe.corners,
+              corner_sharpness=np.linspace(0.5, 3.5, len(fe.corners)))
+    P = hybridsub.limit_positions(V, F, levels=1, **kw)
+    bare = hybridsub.limit_mesh(V, F, normals=False, **kw)
+    full = hybridsub.limit_mesh(V, F, **kw)
+    assert np.array_equal(bare.vertices, P)
+    assert np.abs(full.vertices - P).max() <= 1e-12 * np.linalg.norm(V.max(0) - V.min(0))
+    assert np.array_equal(full.normals, hybridsub.limit_normals(V, F, levels=1, **kw))
+    assert np.array_equal(full.faces, hybridsub.subdivide(V, F, **kw)[1])

@@ -1,7 +1,7 @@
 """Regenerate the figures of docs/features.md, docs/limit.md, docs/analysis.md, docs/semisharp.md,
-docs/face_varying.md and docs/adaptive.md.
+docs/face_varying.md, docs/adaptive.md and docs/usage.md.
 
-usage: python docs/figures/make_figures.py [--out DIR] [--quick]
+usage: python docs/figures/make_figures.py [--out DIR] [--quick] [--only fig_options ...]
 
 Headless (matplotlib's Agg backend). Run it from the repository root with hybridsub
 importable (``pip install ".[plot]"``). ``--quick`` draws smaller versions (for the smoke test).
@@ -339,6 +339,52 @@ def fig_semisharp(out, quick):
         os.path.join(out, "semisharp_cube.png"), optimize=True)
 
 
+def _strip(paths, out_path):
+    """Stack PNGs (same width) into one, shrunk to a 256-colour palette; the parts removed."""
+    from PIL import Image
+
+    rows = [Image.open(p).convert("RGB") for p in paths]
+    img = Image.new("RGB", (rows[0].width, sum(r.height for r in rows)), "white")
+    y = 0
+    for r, p in zip(rows, paths):
+        img.paste(r, (0, y))
+        y += r.height
+        os.remove(p)
+    img.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).save(out_path, optimize=True)
+
+
+def fig_options(out, quick):
+    # docs/usage.md: the options that change the shape. Top: the cube's 8 vertices as corners
+    # of sharpness 0 … ∞ (corner_sharpness=); bottom: holes= against deleting the faces.
+    from hybridsub._app.figure import Panel, render_figure
+
+    V, F = _box()
+    levels = 3 if quick else 4
+    w = 900 if quick else 1200
+    corners = np.arange(len(V))
+    panels = []
+    for s in (0, 1, 2, 3, np.inf):
+        X, G = hybridsub.subdivide(V, F, levels=levels, scheme="loop", corners=corners,
+                                   corner_sharpness=np.full(len(V), float(s)))
+        panels.append(Panel(f"corner_sharpness = {s:g}" if np.isfinite(s) else "corners (∞)", X, G,
+                            f"{len(G):,} faces"))
+    top = os.path.join(out, "_options_corners.png")
+    render_figure(panels, top, width=w, height=w * 30 // 100, view=(35, 25),
+                  title=f"Loop, {levels} levels: the cube's 8 vertices as corners of sharpness s")
+    top_face = np.flatnonzero((V[F][:, :, 2] > 0).all(axis=1))  # the two triangles of the top side
+    keep = np.setdiff1d(np.arange(len(F)), top_face)
+    Vh, Fh = hybridsub.subdivide(V, F, levels=levels, scheme="loop", holes=top_face)
+    Vd, Fd = hybridsub.subdivide(V, F[keep], levels=levels, scheme="loop")
+    Vn, Fn = hybridsub.subdivide(V, F[keep], levels=levels, scheme="loop", boundary="none")
+    panels = [Panel("holes = the top side", Vh, Fh, f"{len(Fh):,} faces: the closed surface, cut"),
+              Panel("the top side deleted", Vd, Fd, f"{len(Fd):,} faces: its boundary a crease"),
+              Panel('deleted, boundary="none"', Vn, Fn, f"{len(Fn):,} faces: the boundary faces left out")]
+    bottom = os.path.join(out, "_options_holes.png")
+    render_figure(panels, bottom, width=w, height=w * 30 // 100, view=(35, 40),
+                  title=f"Loop, {levels} levels: a hole shapes its neighbours, a deleted face does not")
+    _strip([top, bottom], os.path.join(out, "options_cube.png"))
+
+
 def _checkerboard(squares):
     """A texture: ``squares`` × ``squares`` checkerboard over the unit UV square."""
     light, dark = np.array([0.95, 0.93, 0.88]), np.array([0.18, 0.33, 0.6])
@@ -430,9 +476,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=HERE)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--only", nargs="+", metavar="NAME", help="only these figures (e.g. fig_options)")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp, fig_textured, fig_adaptive):
+    figures = {f.__name__: f for f in (fig_features, fig_limit, fig_spectra, fig_charmaps, fig_semisharp,
+                                       fig_textured, fig_adaptive, fig_options)}
+    for f in (figures[n] for n in (args.only or figures)):
         t = time.time()
         f(args.out, args.quick)
         print(f"{f.__name__}: {time.time() - t:.1f} s", file=sys.stderr)

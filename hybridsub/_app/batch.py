@@ -28,6 +28,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 from .._input import check_options, count_of
+from .._input.arrays import check_boundary
 from .._rules import normalize_sharpness
 from .._typing import LoopWeights, Scheme
 from .._units import si
@@ -169,8 +170,9 @@ class BatchSummary:
 
 
 def batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights, fmt, ignore_tags, triangulate,
-                  weld, uv_mode) -> dict:
-    """The options of a batch, checked, as the manifest records them (and its key hashes them)."""
+                  weld, uv_mode, boundary="edge_only") -> dict:
+    """The options of a batch, checked, as the manifest records them (and its key hashes them;
+    ``boundary`` only when it is not the default, so a default batch keeps its key)."""
     levels = check_options(scheme, levels, loop_weights)
     if fmt not in FORMATS:
         raise ValueError(f"format must be one of {FORMATS}, got {fmt!r}")
@@ -193,9 +195,12 @@ def batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights
     names = ("linear", "smooth", "none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
     if uv_mode not in (None,) + names:
         raise ValueError(f"uv_mode must be one of {names}, got {uv_mode!r}")
-    return {"levels": levels, "scheme": scheme, "feature_angle": feature_angle,
-            "feature_sharpness": feature_sharpness, "loop_weights": loop_weights, "format": fmt,
-            "ignore_tags": bool(ignore_tags), "triangulate": bool(triangulate), "weld": bool(weld), "uv_mode": uv_mode}
+    out = {"levels": levels, "scheme": scheme, "feature_angle": feature_angle,
+           "feature_sharpness": feature_sharpness, "loop_weights": loop_weights, "format": fmt,
+           "ignore_tags": bool(ignore_tags), "triangulate": bool(triangulate), "weld": bool(weld), "uv_mode": uv_mode}
+    if check_boundary(boundary) != "edge_only":
+        out["boundary"] = boundary
+    return out
 
 
 
@@ -250,7 +255,8 @@ def options_key(options: dict, version: str) -> str:
 def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str | os.PathLike, *, levels: int = 1,
           scheme: Scheme = "hybrid", feature_angle: float | None = None, feature_sharpness: float | None = None,
           format: str = "obj", loop_weights: LoopWeights = "loop", ignore_tags: bool = False,
-          triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, force: bool = False,
+          triangulate: bool = False, weld: bool = False, uv_mode: str | None = None, boundary: str = "edge_only",
+          force: bool = False,
           scheduler=None, workers: int | None = None, verify: bool = False, dry_run: bool = False,
           lock: bool = True, fsync: bool = False, progress: bool = False,
           on_result: Callable[[dict], None] | None = None) -> BatchSummary:
@@ -272,8 +278,8 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
         ``.obj .ply .off .npz .stl .glb .gltf .3mf .dae .vtk .vtu``) and glob patterns (``**`` allowed).
     outdir : path
         The output folder. Outputs mirror the inputs' names below their folder or pattern.
-    levels, scheme, feature_angle, feature_sharpness, loop_weights, uv_mode
-        As for ``hybridsub subdivide`` (``--feature-sharpness``, ``--uv-mode``; ``uv_mode=None``:
+    levels, scheme, feature_angle, feature_sharpness, loop_weights, uv_mode, boundary
+        As for ``hybridsub subdivide`` (``--feature-sharpness``, ``--uv-mode``, ``--boundary``; ``uv_mode=None``:
         UVs with seams refined linearly, or dropped with a note under ``"sqrt3"``). Tags stored in OBJ, PLY and
         NPZ inputs are used, and propagated into OBJ, PLY and NPZ outputs.
     format : {"obj", "ply", "npz"}
@@ -337,7 +343,7 @@ def batch(inputs: str | os.PathLike | Iterable[str | os.PathLike], outdir: str |
     """
     t_start = time.perf_counter()
     options = batch_options(levels, scheme, feature_angle, feature_sharpness, loop_weights, format, ignore_tags,
-                            triangulate, weld, uv_mode)
+                            triangulate, weld, uv_mode, boundary)
     key = options_key(options, __version__)
     outdir = os.path.abspath(os.fspath(outdir))
     if os.path.exists(outdir) and not os.path.isdir(outdir):

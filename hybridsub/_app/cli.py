@@ -65,7 +65,7 @@ def cmd_batch(a) -> int:
         return 1 if failed else 0
     try:
         s = batch(a.inputs, a.output, levels=a.levels, scheme=a.scheme, feature_angle=a.feature_angle,
-                  feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, format=a.format,
+                  feature_sharpness=a.feature_sharpness, uv_mode=a.uv_mode, boundary=a.boundary, format=a.format,
                   loop_weights=a.loop_weights, ignore_tags=a.ignore_tags, triangulate=a.triangulate, weld=a.weld,
                   force=a.force, scheduler=a.scheduler, workers=a.workers, verify=a.verify, dry_run=a.dry_run,
                   lock=not a.no_lock, fsync=a.fsync, progress=not a.quiet and sys.stderr.isatty())
@@ -440,10 +440,7 @@ def _add_subdivide(sub) -> None:
     s.add_argument("--non-manifold", choices=("raise", "cut"), default="raise", dest="non_manifold",
                    help="edges in three or more faces, or inconsistently oriented: refuse (raise, the default) or cut "
                         "the mesh along them (cut; the pieces meet at creases)")
-    s.add_argument("--boundary", choices=("edge_only", "edge_and_corner", "none"), default="edge_only",
-                   help="OpenSubdiv's boundary interpolation: the boundary is a crease (edge_only, the default); its "
-                        "vertices in one face are corners too (edge_and_corner); or as edge_only with the faces at "
-                        "the boundary left out (none)")
+    _boundary_option(s)
     s.add_argument("--no-tags", action="store_true", help="do not write crease/corner tags into OUT")
     s.add_argument("--ascii", action="store_true", help="PLY output in ASCII instead of binary")
     s.add_argument("--force", action="store_true", help="run even if the memory estimate exceeds this machine's RAM")
@@ -469,6 +466,7 @@ def _add_batch(sub) -> None:
                    help="output format (default: obj); all three keep the tags")
     _tag_options(b, tag_files=False)
     _uv_option(b)
+    _boundary_option(b)
     g = b.add_argument_group("Dask").add_mutually_exclusive_group()
     g.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing cluster, e.g. tcp://10.0.0.5:8786 (default: start a local one)")
@@ -490,6 +488,13 @@ def _add_batch(sub) -> None:
                    help="flush each output and manifest update to the disk (survives a power loss; slower)")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table; failures still listed")
     b.set_defaults(func=cmd_batch, batch_parser=b)
+
+
+def _boundary_option(p) -> None:
+    p.add_argument("--boundary", choices=("edge_only", "edge_and_corner", "none"), default="edge_only",
+                   help="OpenSubdiv's boundary interpolation: the boundary is a crease (edge_only, the default); its "
+                        "vertices in one face are corners too (edge_and_corner); or as edge_only with the faces at "
+                        "the boundary left out (none)")
 
 
 def _add_compare(sub) -> None:

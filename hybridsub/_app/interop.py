@@ -11,7 +11,7 @@ from .._io import METADATA_KEY, classes, kind_of
 from .._errors import MeshError
 from .._input import detect_features, merge_detected, merge_edges
 from .._refiner import Refinement, refine
-from .._typing import ArrayLike, LoopWeights, NonManifold, Scheme, UVMode
+from .._typing import ArrayLike, Boundary, LoopWeights, NonManifold, Scheme, UVMode
 
 if TYPE_CHECKING:  # pragma: no cover
     import pyvista
@@ -24,7 +24,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
                    feature_angle: float | None = None, loop_weights: LoopWeights = "loop",
                    weld: bool | None = None, uv_mode: UVMode = "linear",
                    non_manifold: NonManifold = "raise", progress: bool | None = False,
-                   holes: ArrayLike | None = None, uv_interpolation: str | None = None) -> Any:
+                   holes: ArrayLike | None = None, uv_interpolation: str | None = None,
+                   corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only") -> Any:
     """Subdivide a ``trimesh.Trimesh`` or a ``pyvista.PolyData``, carrying its attributes and
     features along; the result is of the type given.
 
@@ -68,8 +69,9 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
     scheme : {"hybrid", "sqrt3", "loop"}
         ``"sqrt3"`` cannot keep UV seams: with a welded textured mesh it raises ``ValueError``
         (use ``weld=False`` to refine the mesh as stored, seams open).
-    sharp_edges, sharpness, sharp_faces, corners
-        As for :func:`hybridsub.subdivide`, in ``mesh``'s vertex and face indices.
+    sharp_edges, sharpness, sharp_faces, corners, corner_sharpness, boundary
+        As for :func:`hybridsub.subdivide`, in ``mesh``'s vertex and face indices (welded
+        copies of a corner take its sharpest value).
     feature_angle : float, optional
         Also tag what :func:`hybridsub.detect_features` finds at this dihedral angle (degrees),
         by the rule of :func:`hybridsub.subdivide`: its sharp edges (infinitely sharp, unless
@@ -108,7 +110,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
         it is the UV index layout of ``docs/face_varying.md``: the input's vertices first,
         copies with equal position, UV and data merged).
         ``metadata["hybridsub"]`` holds ``sharp_edges``, ``sharpness``, ``corners``,
-        ``sharp_faces`` (indices), ``face_parent``, ``scheme`` and ``levels``.
+        ``sharp_faces`` (indices), ``face_parent``, ``scheme`` and ``levels``, and with
+        semi-sharp corners their ``corner_sharpness`` left (each decayed by ``levels``).
 
     Examples
     --------
@@ -139,7 +142,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
                               sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
                               feature_angle=feature_angle, loop_weights=loop_weights, weld=weld, uv_mode=uv_mode,
                               non_manifold=non_manifold, progress=progress, holes=holes,
-                              uv_interpolation=uv_interpolation)
+                              uv_interpolation=uv_interpolation, corner_sharpness=corner_sharpness,
+                              boundary=boundary)
         return trimesh_as_polydata(fine, uv_name)
     if kind != "trimesh":
         raise TypeError(f"mesh must be a trimesh.Trimesh or a pyvista.PolyData, got {type(mesh).__name__} "
@@ -155,6 +159,8 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
             and isinstance(stored, dict) and scheme != "sqrt3"):
         sharp_edges, sharpness = stored.get("sharp_edges"), stored.get("sharpness")
         sharp_faces, corners = stored.get("sharp_faces"), stored.get("corners")
+        if corner_sharpness is None and corners is not None:
+            corner_sharpness = stored.get("corner_sharpness")
     uv = _vertex_uv(mesh)
     if weld is None:  # a triangle soup (STL loaded with process=False) or a textured mesh's seam copies
         weld = uv is not None or len(np.unique(V, axis=0)) < n
@@ -168,14 +174,16 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
             'a triangle spanning two UV charts); use scheme="hybrid" or "loop", or weld=False to refine the mesh '
             "as stored (its seams open, as boundaries)")
 
-    edges_w, sharp_w, corners_w = _welded_tags(w, n, sharp_edges, sharpness, corners, feature_angle)
+    edges_w, sharp_w, corners_w, csharp_w = _welded_tags(w, n, sharp_edges, sharpness, corners, corner_sharpness,
+                                                         feature_angle)
 
     try:
         r = refine(w.F, edges_w, levels, n_vertices=len(w.V), scheme=scheme, sharpness=sharp_w,
                    sharp_faces=sharp_faces, corners=corners_w, loop_weights=loop_weights,
                    uv_faces=w.FUV if w.face_varying else None, uv_mode=uv_mode,
                    n_uvs=w.n_corners if w.face_varying else None, non_manifold=non_manifold,
-                   progress=progress, holes=holes, uv_interpolation=uv_interpolation)
+                   progress=progress, holes=holes, uv_interpolation=uv_interpolation,
+                   corner_sharpness=csharp_w, boundary=boundary)
     except MeshError as e:
         if not w.welded:
             raise
@@ -197,17 +205,21 @@ def subdivide_mesh(mesh: trimesh.Trimesh | pyvista.PolyData, levels: int = 1, *,
         "sharp_faces": np.flatnonzero(sf) if sf.dtype == bool else sf,
         "face_parent": parent, "scheme": scheme, "levels": int(levels),
     }
+    if r.corner_sharpness is not None:  # one value per output vertex of each corner
+        metadata[METADATA_KEY]["corner_sharpness"] = out.vertex_values_of(r.corners, r.corner_sharpness)
     return trimesh.Trimesh(out.positions(), out.faces, visual=visual, process=False, validate=False,
                            metadata=metadata, vertex_attributes=vattr, face_attributes=fattr)
 
 
-def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angle):
-    """The caller's tags in the welded vertex numbers, and the features detected on the welded
-    mesh merged in by the gate's rule (:func:`merge_detected`: the caller's sharpness wins, as
-    in :func:`hybridsub.subdivide`); None where there are none."""
+def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, corner_sharpness, feature_angle):
+    """The caller's tags in the welded vertex numbers (edges, their sharpness, corners, the
+    corners' sharpness), and the features detected on the welded mesh merged in by the gate's
+    rule (:func:`merge_detected`: the caller's sharpness wins, as in
+    :func:`hybridsub.subdivide`; detected corners infinitely sharp); None where there are none."""
     edges_w: np.ndarray | None = None
     sharp_w: np.ndarray | None = None
     corners_w: np.ndarray | None = None
+    vs_w: np.ndarray | None = None  # (n_w,) every welded vertex's sharpness, with semi-sharp corners
     if sharp_edges is not None:
         pairs, sharp_w = val.as_sharp_edges(sharp_edges, sharpness, n)
         edges_w = w.geo[pairs]
@@ -219,7 +231,13 @@ def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angl
     elif sharpness is not None and np.size(sharpness):
         raise ValueError("sharpness was given without sharp_edges")
     if corners is not None:
-        corners_w = np.unique(w.geo[np.flatnonzero(val.as_corner_mask(corners, n))])
+        mask, vs = val.as_corner_sharpness(corners, corner_sharpness, n)
+        corners_w = np.unique(w.geo[np.flatnonzero(mask)])
+        if vs is not None:
+            vs_w = np.zeros(len(w.V))
+            np.maximum.at(vs_w, w.geo, vs)  # copies of one corner: its sharpest value
+    elif corner_sharpness is not None:
+        raise ValueError("corner_sharpness was given without corners")
     if feature_angle is not None:
         feat = detect_features(w.V, w.F, feature_angle)
         nw = len(w.V)
@@ -231,7 +249,10 @@ def _welded_tags(w: _Weld, n: int, sharp_edges, sharpness, corners, feature_angl
         mask[np.empty(0, np.int64) if corners_w is None else corners_w] = True
         edges_w, sharp_w, mask = merge_detected(feat, edges_w, sharp_w, mask, nw)
         corners_w = np.flatnonzero(mask)
-    return edges_w, sharp_w, corners_w
+        if vs_w is not None:
+            vs_w[mask & (vs_w == 0)] = np.inf
+    csharp_w = None if vs_w is None or corners_w is None else vs_w[corners_w]
+    return edges_w, sharp_w, corners_w, csharp_w
 
 
 # ---------------------------------------------------------------------------------------
@@ -315,6 +336,14 @@ class _Output:
         if self.uv_r is not None:
             return self.uv_r.apply(uv[self.corner_first])
         return self.r.apply(uv[self.w.geo_first])
+
+    def vertex_values_of(self, v: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """``values`` of the welded vertices ``v``, at the output vertices :meth:`vertices_of` gives."""
+        if self.geo_of is None:
+            return np.asarray(values, np.float64)
+        full = np.zeros(self.r.n_vertices)
+        full[np.asarray(v, np.int64)] = values
+        return full[self.geo_of[self.vertices_of(v)]]
 
     def vertices_of(self, v: np.ndarray) -> np.ndarray:
         """Output vertices at the welded vertices ``v`` (every copy)."""

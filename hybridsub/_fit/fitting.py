@@ -260,7 +260,7 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
         sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
         V0: ArrayLike | None = None, levels: int | None = None, smoothness: float = 0.0, max_iterations: int = 50,
         tol: float = 1e-12, loop_weights: LoopWeights = "loop", feature_angle: float | None = None,
-        callback=None) -> FitResult:
+        callback=None, corner_sharpness: ArrayLike | None = None) -> FitResult:
     """Control positions whose subdivision surface is closest to target points.
 
     Alternates the closest points of the targets on the current surface and a sparse
@@ -276,8 +276,9 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
         The control mesh's triangles.
     points : (p, 3) array_like of float
         Target points (a scan, a dense mesh's vertices).
-    sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
-        The control mesh's tags and rules, as in :func:`hybridsub.refine`.
+    sharp_edges, scheme, sharpness, sharp_faces, corners, corner_sharpness, loop_weights
+        The control mesh's tags and rules, as in :func:`hybridsub.refine` (``holes=`` and
+        ``boundary=`` are not taken: the targets are fitted to every face).
     V0 : (n, 3) array_like of float, optional
         Starting control positions, usually the control mesh's own (``fit(F, P, V0=V)``);
         vertices no face uses are allowed and stay where they are. Default: the first n target
@@ -350,7 +351,7 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
             raise MeshError(f"V0 must have one row per control vertex (at least {n_used}, the faces use vertex "
                             f"{n_used - 1}), got shape {np.shape(as_vertices(V0))}")
     tags = dict(scheme=scheme, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                loop_weights=loop_weights)
+                loop_weights=loop_weights, corner_sharpness=corner_sharpness)
     r = refine(F, sharp_edges, 0 if levels is None else levels, n_vertices=n_given, **tags)
     if len(r.faces) == 0:
         raise MeshError("F has no faces: there is no surface to fit")
@@ -360,6 +361,8 @@ def fit(F: ArrayLike, points: ArrayLike, sharp_edges: ArrayLike | None = None, *
         inp = open_gate(F, sharp_edges, 0, n_vertices=n, positions=V, feature_angle=feature_angle, **tags)
         sharp_edges, tags["sharpness"] = inp.sharp_edges, inp.sharpness
         tags["corners"] = np.flatnonzero(inp.corner)
+        if inp.corner_sharpness is not None:  # the caller's semi-sharp ones keep their sharpness
+            tags["corner_sharpness"] = inp.corner_sharpness[tags["corners"]]
         r = refine(F, sharp_edges, 0 if levels is None else levels, n_vertices=n, **tags)
     centre, scale = _normalisation(pts, V)
     pts, V = (pts - centre) / scale, (V - centre) / scale

@@ -112,17 +112,19 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
                corners: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                vertex_colors: ArrayLike | None = None, uv: ArrayLike | None = None,
                face_uv: ArrayLike | None = None, binary: bool = True,
-               corner_sharpness: ArrayLike | None = None) -> None:
+               corner_sharpness: ArrayLike | None = None, holes: ArrayLike | None = None) -> None:
     """Write a triangle mesh with its feature tags: arrays, or a mesh object in one line.
 
-    OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, 0-based,
-    ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``crease`` (vertex1, vertex2,
-    sharpness), ``corner`` and ``sharp_face`` header comments (which every PLY reader skips);
-    NPZ one array per attribute (the names of :class:`TaggedMesh`'s, ``inf`` for infinitely
-    sharp); meshio's formats (VTK, VTU, XDMF, …) creases as ``line`` cells and corners as
-    ``vertex`` cells with cell data ``sharpness`` (see docs/formats.md); OFF and the formats
-    trimesh writes (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which tags were
-    dropped.
+    OBJ gets OpenSubdiv's tags (``t crease 2/1/0 i j s``, ``t corner 1/1/0 v s``, ``t hole``,
+    0-based, ``s = 10`` for infinitely sharp) and ``t sharpface``; PLY gets ``crease`` (vertex1,
+    vertex2, sharpness), ``corner``, ``sharp_face`` and ``hole`` header comments (which every
+    PLY reader skips); NPZ one array per attribute (the names of :class:`TaggedMesh`'s, ``inf``
+    for infinitely sharp); meshio's formats (VTK, VTU, XDMF) creases as ``line`` cells and
+    corners as ``vertex`` cells with cell data ``sharpness``, sharp faces and holes as triangle
+    cell data ``sharp_face`` and ``hole`` (see docs/formats.md); OFF, meshio's other formats and
+    the formats trimesh writes (STL, GLB, …) hold geometry only, and a ``UserWarning`` says which
+    tags (holes among them) were dropped. No format holds ``boundary=``: it is an option of the
+    refinement, not of the mesh.
 
     ``write_mesh(path, mesh)`` writes a ``trimesh.Trimesh`` (its tags from
     ``metadata["hybridsub"]``, as :func:`hybridsub.subdivide_mesh` leaves them), a
@@ -144,6 +146,10 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
     corner_sharpness : (c,) array_like of float, optional
         Sharpness of each of ``corners`` (default ``inf``, written as 10): OBJ's ``t corner``
         value, PLY's ``corner`` comment, NPZ's ``corner_sharpness``, meshio's cell data.
+    holes : array_like of int or (m,) bool mask, optional
+        Faces not rendered that still shape their neighbours (``holes=`` of
+        :func:`hybridsub.subdivide`): OBJ's ``t hole``, PLY's ``hole`` comment, NPZ's
+        ``holes``, meshio's ``hole`` cell data.
     vertex_colors : (n, 3 or 4) array_like, optional
         Floats in [0, 1] or integers in 0..255.
     uv : (n, 2) or (t, 2) array_like of float, optional
@@ -167,7 +173,7 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
     1444
     """
     mesh = _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
-                    corner_sharpness)
+                    corner_sharpness, holes)
     dropped = write(os.fspath(path), mesh, binary=binary)
     if dropped:
         warnings.warn(f"{os.fspath(path)}: this format cannot hold {dropped}; write .obj or .ply to keep them",
@@ -176,7 +182,7 @@ def write_mesh(path: str | os.PathLike, vertices: ArrayLike | Any, faces: ArrayL
 
 
 def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
-             corner_sharpness=None) -> TaggedMesh:
+             corner_sharpness=None, holes=None) -> TaggedMesh:
     """write_mesh's arguments as a TaggedMesh: arrays, or a mesh object and optional tags."""
     kind = "tagged" if isinstance(vertices, TaggedMesh) else kind_of(vertices)
     if kind is None:
@@ -184,14 +190,14 @@ def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vert
             raise TypeError("write_mesh(path, vertices, faces, ...) needs faces, or write_mesh(path, mesh) a "
                             f"trimesh.Trimesh, pyvista.PolyData or hybridsub.TaggedMesh; got {type(vertices).__name__}")
         return as_tagged(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vertex_colors, uv, face_uv,
-                         corner_sharpness)
+                         corner_sharpness, holes)
     if faces is not None:
         raise TypeError(f"write_mesh(path, mesh) takes no faces: the {type(vertices).__name__} has its own")
     if vertex_colors is not None or uv is not None or face_uv is not None:
         raise TypeError("write_mesh(path, mesh): colours and UVs come from the mesh; pass arrays to set them")
     m = vertices if kind == "tagged" else from_trimesh(vertices) if kind == "trimesh" else from_pyvista(vertices)
     if sharp_edges is None and sharpness is None and corners is None and sharp_faces is None \
-            and corner_sharpness is None:
+            and corner_sharpness is None and holes is None:
         return m
     tags = m.tag_arrays()
     if sharp_edges is not None or sharpness is not None:
@@ -200,9 +206,10 @@ def _as_mesh(vertices, faces, sharp_edges, sharpness, corners, sharp_faces, vert
         tags["corners"] = tags["corners"] if corners is None else corners
         tags["corner_sharpness"] = corner_sharpness
     tags["sharp_faces"] = tags["sharp_faces"] if sharp_faces is None else sharp_faces
+    tags["holes"] = m.holes if holes is None else holes
     checked = as_tagged(m.vertices, m.faces, **tags)
     return replace(m, sharp_edges=checked.sharp_edges, sharpness=checked.sharpness, corners=checked.corners,
-                   sharp_faces=checked.sharp_faces, corner_sharpness=checked.corner_sharpness)
+                   sharp_faces=checked.sharp_faces, corner_sharpness=checked.corner_sharpness, holes=checked.holes)
 
 
 def check_writable(path: str, *, binary: bool = True) -> None:

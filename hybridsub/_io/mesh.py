@@ -432,5 +432,7 @@ def describe_tags(mesh: TaggedMesh) -> str:
         parts.append(count_of(len(mesh.corners), "corner"))
     if len(mesh.sharp_faces):
         parts.append(count_of(len(mesh.sharp_faces), "sharp face"))
+    if len(mesh.holes):
+        parts.append(count_of(len(mesh.holes), "hole"))
     return ", ".join(parts)
 

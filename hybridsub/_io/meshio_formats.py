@@ -2,7 +2,8 @@
 Abaqus, …): triangles, with the tags as cells of their own where the format holds mixed cells
 — creases as ``line`` cells, corners as ``vertex`` cells, each with cell data
 ``"sharpness"`` (10 = infinitely sharp), sharp faces as triangle cell data ``"sharp_face"``
-(1 = sharp). meshio is imported only when such a file is read or written."""
+(1 = sharp) and holes as ``"hole"`` (1 = a face not rendered, ``holes=``). meshio is
+imported only when such a file is read or written."""
 
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     if P.ndim != 2 or P.shape[1] not in (2, 3):
         raise MeshError(f"{path}: points of shape {P.shape}; a surface mesh needs 2 or 3 coordinates")
     V = np.pad(P, ((0, 0), (0, 3 - P.shape[1])))
-    polys, sharp_face, pairs, psharp, corners, csharp, notes = [], [], [], [], [], [], []
+    polys, sharp_face, hole, pairs, psharp, corners, csharp, notes = [], [], [], [], [], [], [], []
     _check_cells(path, mesh, len(V))
     for i, block in enumerate(mesh.cells):
         try:
@@ -61,6 +62,7 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
             polys += [list(map(int, c)) for c in block.data]
             sf = data.get("sharp_face")
             sharp_face.append(np.zeros(len(block.data), bool) if sf is None else sf[:, 0] > 0)
+            hole.append(_hole_marks(path, block, data.get("hole"), sum(len(h) for h in hole)))
         elif block.type == "line" and "sharpness" in data:
             pairs.append(np.asarray(block.data, np.int64))
             psharp.append(data["sharpness"][:, 0].astype(np.float64))
@@ -72,6 +74,8 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     F, origin = triangulate_polygons(path, polys, triangulate)
     mask = np.concatenate(sharp_face) if sharp_face else np.zeros(0, bool)
     sf = np.flatnonzero(mask[origin] if origin is not None else mask)
+    hmask = np.concatenate(hole) if hole else np.zeros(0, bool)
+    H = np.flatnonzero(hmask[origin] if origin is not None else hmask)
     E = np.concatenate(pairs) if pairs else np.empty((0, 2), np.int64)
     s = np.concatenate(psharp) if psharp else np.empty(0)
     if np.isnan(s).any():
@@ -94,7 +98,22 @@ def read_meshio(path: str, triangulate: bool) -> TaggedMesh:
     if origin is not None:
         notes.append(f"triangulated {len(polys)} polygons into {len(F)} triangles")
     notes += said
-    return TaggedMesh(V, F, E, s, C, sf.astype(np.int64), colors, uv, face_uv, tuple(notes), corner_sharpness=Cs)
+    return TaggedMesh(V, F, E, s, C, sf.astype(np.int64), colors, uv, face_uv, tuple(notes), corner_sharpness=Cs,
+                      holes=H.astype(np.int64))
+
+
+def _hole_marks(path: str, block, marks, first: int) -> np.ndarray:
+    """The ``hole`` cell data of a block of surface cells as a mask: each value 0 or 1 (a
+    MeshError names the first other one; ``first``: the block's first face number)."""
+    if marks is None:
+        return np.zeros(len(block.data), bool)
+    v = marks[:, 0]
+    bad = ~((v == 0) | (v == 1))
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
+        raise MeshError(f"{path}: the 'hole' cell data of {block.type} cell {j} (face {first + j}) is {v[j]}; "
+                        "give 1 for a hole, 0 for a face rendered")
+    return v == 1
 
 
 def _meshio_read(path: str):
@@ -191,16 +210,23 @@ def write_meshio(path: str, m: TaggedMesh) -> str:
         sf = np.zeros(len(m.faces), np.uint8)
         sf[m.sharp_faces] = 1
         marks = [sf]
+        hf = np.zeros(len(m.faces), np.uint8)
+        hf[m.holes] = 1
+        holes = [hf]
         if len(m.sharp_edges):
             cells.append(("line", m.sharp_edges))
             sharp.append(sharpness_to_file(m.sharpness))
             marks.append(np.zeros(len(m.sharp_edges), np.uint8))
+            holes.append(np.zeros(len(m.sharp_edges), np.uint8))
         if len(m.corners):
             cells.append(("vertex", np.asarray(m.corners).reshape(-1, 1)))
             sharp.append(corner_values(m))
             marks.append(np.zeros(len(m.corners), np.uint8))
-        tagged = meshio.Mesh(m.vertices, cells, point_data=point_data,
-                             cell_data={"sharpness": sharp, "sharp_face": marks})
+            holes.append(np.zeros(len(m.corners), np.uint8))
+        cell_data = {"sharpness": sharp, "sharp_face": marks}
+        if len(m.holes):
+            cell_data["hole"] = holes
+        tagged = meshio.Mesh(m.vertices, cells, point_data=point_data, cell_data=cell_data)
         _meshio_write(path, tagged)
         return ""
     try:

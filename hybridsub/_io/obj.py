@@ -223,7 +223,15 @@ def _obj_finish(path, v_rows, vt_rows, faces, fuv, extras: _ObjExtras, triangula
         sharp_faces = np.flatnonzero(np.isin(origin, sharp_faces))
     if origin is not None and len(holes):  # every triangle of a polygon hole is a hole
         holes = np.flatnonzero(np.isin(origin, holes))
-    if boundary_corners:  # OpenSubdiv's VTX_BOUNDARY_EDGE_AND_CORNER
+    if boundary_corners == "none":  # VTX_BOUNDARY_NONE: the faces at the boundary are holes
+        at = np.flatnonzero(np.isin(F, boundary_vertices(F)).any(axis=1))
+        if origin is not None:  # the whole polygon, as OpenSubdiv tags the face
+            at = np.flatnonzero(np.isin(origin, origin[at]))
+        if len(at):
+            tag_notes.append(f"'interpolateboundary 0': {count_of(len(np.setdiff1d(at, holes)), 'face')} at the "
+                             "boundary made holes (boundary=\"none\")")
+        holes = np.union1d(holes, at).astype(np.int64)
+    if boundary_corners == "edge_and_corner":  # OpenSubdiv's VTX_BOUNDARY_EDGE_AND_CORNER
         extra = np.setdiff1d(boundary_corner_vertices(F), corners)
         if corner_s is not None:  # all of them infinitely sharp (OpenSubdiv's SharpenBoundaryVertex)
             corner_s = np.concatenate([corner_s, np.full(len(extra), np.inf)])[np.argsort(np.r_[corners, extra])]
@@ -306,7 +314,7 @@ def _parse_tags(path, tags, n_vertices, n_faces):
     """OpenSubdiv's ``t name nint/nfloat[/nstring] ints floats strings`` lines."""
     edges, edge_s, corners, corner_s, faces, holes = [], [], [], [], [], []
     notes, unknown = [], set()
-    boundary_corners = False
+    boundary_corners = None  # boundary= the file asks for, where not "edge_only"
     for number, w in tags:
         where = f"{path}: line {number}"
         name, ints, floats = _tag_values(where, w)
@@ -331,12 +339,12 @@ def _parse_tags(path, tags, n_vertices, n_faces):
             faces.extend(ints)
         elif name == "hole":  # OpenSubdiv's face holes: 0-based face indices
             holes.extend(ints)
-        elif name == "interpolateboundary":
-            if ints and ints[0] == 2:
-                boundary_corners = True
-            elif ints and ints[0] not in (1,):
-                notes.append(f"tag 'interpolateboundary {ints[0]}' ignored: boundaries are always "
-                             "creases (OpenSubdiv's VTX_BOUNDARY_EDGE_ONLY)")
+        elif name == "interpolateboundary":  # OpenSubdiv's Sdc VtxBoundaryInterpolation: 0 none, 1, 2
+            if ints and ints[0] in (0, 2):
+                boundary_corners = "none" if ints[0] == 0 else "edge_and_corner"
+            elif ints and ints[0] != 1:
+                notes.append(f"tag 'interpolateboundary {ints[0]}' ignored: OpenSubdiv knows 0 (none), 1 (edge "
+                             "only) and 2 (edge and corner)")
         else:
             unknown.add(name)
     if unknown:
@@ -379,6 +387,20 @@ def _tag_corners(path, corners, corner_s, n_vertices):
         raise MeshError(f"{path}: corner tag names vertex {int(C[bad][0])}, but the file has {n_vertices} "
                         f"vertices (0..{n_vertices - 1})")
     return corner_tags(C, cs)
+
+
+def boundary_vertices(F: np.ndarray) -> np.ndarray:
+    """Vertices on a boundary edge (an edge in one face).
+
+    >>> boundary_vertices(np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 4]])).tolist()
+    [1, 2, 3, 4]
+    """
+    if not len(F):
+        return np.empty(0, np.int64)
+    u, w = halfedge_ends(F)
+    g = group_halfedges(u, w)
+    bnd = g.sizes[g.group] == 1
+    return np.unique(np.concatenate([u[bnd], w[bnd]]))
 
 
 def boundary_corner_vertices(F: np.ndarray) -> np.ndarray:

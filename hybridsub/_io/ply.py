@@ -359,8 +359,9 @@ def read_ply_mesh(path: str, triangulate: bool) -> TaggedMesh:
     E, s = _ply_creases(path, el, tags, n)
     C, Cs = _ply_corners(path, el, tags, n)
     S = _ply_sharp_faces(path, el, tags, len(polys), origin)
+    H = _ply_holes(path, tags, len(polys), origin)
     return TaggedMesh(np.ascontiguousarray(V), np.ascontiguousarray(F), E, s, C, S, colors, uv, face_uv,
-                      tuple(notes), corner_sharpness=Cs)
+                      tuple(notes), corner_sharpness=Cs, holes=H)
 
 
 def _ply_vertices(path: str, el: dict[str, dict]) -> tuple[np.ndarray, np.ndarray | None]:
@@ -393,8 +394,8 @@ def _ply_uv(vd: dict, fd: dict, F: np.ndarray, origin: np.ndarray | None):
 
 
 #: Header comments that hold hybridsub's tags (every PLY reader skips comments), and the
-#: numbers per tag: crease v1 v2 sharpness; corner v sharpness; sharp_face f.
-_TAG_WIDTH = {"crease": 3, "corner": 2, "sharp_face": 1}
+#: numbers per tag: crease v1 v2 sharpness; corner v sharpness; sharp_face f; hole f.
+_TAG_WIDTH = {"crease": 3, "corner": 2, "sharp_face": 1, "hole": 1}
 _TAGS_PER_LINE = 16
 
 
@@ -424,7 +425,7 @@ def _comment_tags(path: str, comments: list[str]) -> dict[str, np.ndarray]:
 
 
 _TAG_FIELDS = {"crease": ("vertex1", "vertex2", "sharpness"), "corner": ("vertex", "sharpness"),
-               "sharp_face": ("face",)}
+               "sharp_face": ("face",), "hole": ("face",)}
 
 
 def _vertex_ids(path: str, what: str, A: np.ndarray, n: int, noun: str = "vertices") -> np.ndarray:
@@ -493,12 +494,20 @@ def _ply_sharp_faces(path: str, el: dict[str, dict], tags: dict, nf: int, origin
     return np.flatnonzero(np.isin(origin, S)) if origin is not None else np.unique(S)
 
 
+def _ply_holes(path: str, tags: dict, nf: int, origin: np.ndarray | None) -> np.ndarray:
+    """Holes of the ``hole`` comments, as triangles (every triangle of a polygon hole)."""
+    if "hole" not in tags:
+        return np.empty(0, np.int64)
+    H = _vertex_ids(path, "hole", tags["hole"], nf, "face")[:, 0]
+    return np.flatnonzero(np.isin(origin, H)) if origin is not None else np.unique(H)
+
+
 def write_ply_mesh(path: str, m: TaggedMesh, binary: bool) -> None:
     """Write ``m`` as PLY (binary little-endian or ASCII): ``vertex`` and ``face`` elements
     only, so that every PLY reader reads it (meshio reads no other element); the tags as
     header comments, which every reader skips: ``comment crease v1 v2 s …`` (0-based, sharpness
-    10 = infinitely sharp), ``comment corner v s …``, ``comment sharp_face f …``, up to 16 tags
-    a line.
+    10 = infinitely sharp), ``comment corner v s …``, ``comment sharp_face f …``,
+    ``comment hole f …`` (faces not rendered, ``holes=``), up to 16 tags a line.
 
     Examples
     --------
@@ -523,10 +532,11 @@ def write_ply_mesh(path: str, m: TaggedMesh, binary: bool) -> None:
     comments = [f"hybridsub {__version__}"]
     if m.has_tags:
         comments.append("tags: crease vertex1 vertex2 sharpness (0-based, 10 = infinitely sharp); "
-                        "corner vertex sharpness; sharp_face face")
+                        "corner vertex sharpness; sharp_face face; hole face")
     comments += _tag_lines("crease", [m.sharp_edges[:, 0], m.sharp_edges[:, 1], sharpness_to_file(m.sharpness)])
     comments += _tag_lines("corner", [np.asarray(m.corners), corner_values(m)])
     comments += _tag_lines("sharp_face", [np.asarray(m.sharp_faces)])
+    comments += _tag_lines("hole", [np.asarray(m.holes)])
     write_ply(path, [("vertex", vertex), ("face", face)], binary=binary, comments=tuple(comments))
 
 

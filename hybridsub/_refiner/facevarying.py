@@ -33,9 +33,9 @@ import scipy.sparse as sp
 
 from .._input import as_uv_values, as_vertices, open_gate
 from .._topology import seam_halfedges
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NDArray, NonManifold, Scheme, UVMode
 from .fastpath import walk_data
-from .refinement import Refinement, refine
+from .refinement import Refinement, refine, refinement_of, without_holes
 
 
 class FaceVaryingRefinement(NamedTuple):
@@ -97,7 +97,9 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
                         uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                         sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                         loop_weights: LoopWeights = "loop", non_manifold: NonManifold = "raise",
-                        max_memory: MemoryLimit = None, uv_interpolation: str | None = None) -> FaceVaryingRefinement:
+                        max_memory: MemoryLimit = None, uv_interpolation: str | None = None,
+                        corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                        holes: ArrayLike | None = None) -> FaceVaryingRefinement:
     """Refine a mesh's connectivity together with its face-varying (UV) index mesh.
 
     ``refine(F, ..., uv_faces=FUV)`` returns the ``geometry`` part of this, with the UV faces
@@ -114,6 +116,8 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
         index (a degenerate UV triangle).
     sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights, non_manifold, max_memory
         As in :func:`hybridsub.refine`.
+    corner_sharpness, boundary, holes
+        As in :func:`hybridsub.refine` (the UV faces of holes are left out with the faces).
     n_vertices : int, optional
         Number of vertices; default ``F.max() + 1``.
     n_uvs : int, optional
@@ -146,7 +150,8 @@ def refine_face_varying(F: ArrayLike, FUV: ArrayLike, sharp_edges: ArrayLike | N
     geo = refine(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                  sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, non_manifold=non_manifold,
                  max_memory=max_memory, uv_faces=FUV, n_uvs=n_uvs, uv_mode=uv_mode,
-                 uv_interpolation=uv_interpolation)
+                 uv_interpolation=uv_interpolation, corner_sharpness=corner_sharpness, boundary=boundary,
+                 holes=holes)
     assert geo.uv_refinement is not None  # refine attaches it whenever uv_faces is given
     return FaceVaryingRefinement(geo, geo.uv_refinement)
 
@@ -160,7 +165,8 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
                            corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
                            return_matrix: Literal[False] = ..., max_memory: MemoryLimit = ...,
-                           uv_interpolation: str | None = ...) -> _Textured: ...
+                           uv_interpolation: str | None = ..., corner_sharpness: ArrayLike | None = ...,
+                           boundary: Boundary = ..., holes: ArrayLike | None = ...) -> _Textured: ...
 
 
 @overload
@@ -169,7 +175,8 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            uv_mode: UVMode = ..., sharpness: ArrayLike | None = ..., sharp_faces: ArrayLike | None = ...,
                            corners: ArrayLike | None = ..., loop_weights: LoopWeights = ...,
                            return_matrix: Literal[True], max_memory: MemoryLimit = ...,
-                           uv_interpolation: str | None = ...) -> tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64],
+                           uv_interpolation: str | None = ..., corner_sharpness: ArrayLike | None = ...,
+                           boundary: Boundary = ..., holes: ArrayLike | None = ...) -> tuple[NDArray[np.floating], NDArray[np.int64], NDArray[np.floating], NDArray[np.int64],
                                       sp.csr_matrix, sp.csr_matrix]: ...
 
 
@@ -178,7 +185,9 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
                            uv_mode: UVMode = "linear", sharpness: ArrayLike | None = None,
                            sharp_faces: ArrayLike | None = None, corners: ArrayLike | None = None,
                            loop_weights: LoopWeights = "loop", return_matrix: bool = False,
-                           max_memory: MemoryLimit = None, uv_interpolation: str | None = None) -> tuple:
+                           max_memory: MemoryLimit = None, uv_interpolation: str | None = None,
+                           corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                           holes: ArrayLike | None = None) -> tuple:
     """Subdivide a textured triangle mesh: positions and UVs with seams, faces kept aligned.
 
     Parameters
@@ -193,6 +202,8 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
         Index into ``UV`` of each face corner, aligned row by row with ``F``.
     sharp_edges, levels, sharpness, sharp_faces, corners, loop_weights, max_memory
         As in :func:`hybridsub.subdivide`.
+    corner_sharpness, boundary, holes
+        As in :func:`hybridsub.subdivide` (``FUV2`` leaves out the rows of the faces left out).
     scheme : {"hybrid", "loop"}
         ``"hybrid"`` splits seam edges (R4) instead of flipping them, so its geometry differs
         from :func:`subdivide` along seams; ``"loop"`` geometry equals :func:`subdivide`'s.
@@ -233,18 +244,19 @@ def subdivide_face_varying(V: ArrayLike, F: ArrayLike, UV: ArrayLike, FUV: Array
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
     U = np.asarray(UV)
     uv_dtype = U.dtype if np.issubdtype(U.dtype, np.floating) else np.float64
-    if return_matrix:
-        r = refine_face_varying(F, FUV, sharp_edges, levels, n_vertices=len(Vf), n_uvs=len(UVf), scheme=scheme,
-                                uv_mode=uv_mode, sharpness=sharpness, sharp_faces=sharp_faces, corners=corners,
-                                loop_weights=loop_weights, max_memory=max_memory,
-                                uv_interpolation=uv_interpolation)
-        V2 = r.geometry.apply(Vf).astype(out_dtype, copy=False)
-        UV2 = r.uv.apply(UVf).astype(uv_dtype, copy=False)
-        return V2, r.geometry.faces, UV2, r.uv.faces, r.geometry.matrix, r.uv.matrix
     inp = open_gate(F, sharp_edges, levels, n_vertices=len(Vf), scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, max_memory=max_memory,
                     uv_faces=FUV, n_uvs=len(UVf), uv_mode=uv_mode, uv_name="FUV",
-                    uv_interpolation=uv_interpolation)
+                    uv_interpolation=uv_interpolation, corner_sharpness=corner_sharpness, boundary=boundary,
+                    holes=holes)
+    if return_matrix or inp.hole is not None:  # holes: the faces left out through the refinement's face parents
+        geo = without_holes(refinement_of(inp), inp.hole)
+        uv = geo.uv_refinement
+        V2 = geo.apply(Vf).astype(out_dtype, copy=False)
+        UV2 = uv.apply(UVf).astype(uv_dtype, copy=False)
+        if return_matrix:
+            return V2, geo.faces, UV2, uv.faces, geo.matrix, uv.matrix
+        return V2, geo.faces, UV2, uv.faces
     last = None
     for last in walk_data(inp, Vf, UVf.reshape(len(UVf), -1)):
         pass

@@ -106,8 +106,11 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
 class PatchTable:
     """Keys, representatives and the transition tables of one scheme (see the module doc)."""
 
-    def __init__(self, scheme: str, loop_weights: str, tol: float = 1e-12, max_levels: int = 60):
+    def __init__(self, scheme: str, loop_weights: str, tol: float = 1e-12, max_levels: int = 60,
+                 vertex_sharpness: bool = False):
         self.scheme, self.loop_weights = scheme, loop_weights
+        # Corner tags as a mask, or (semi-sharp corners) as each vertex's sharpness left.
+        self.vertex_sharpness = vertex_sharpness
         self.tol, self.max_levels = tol, max_levels
         self.index: dict[tuple, int] = {}  # key hash → key id
         # The representatives, canonical, one after another: key k's faces rep_f0[k]:+rep_nf[k]
@@ -117,7 +120,8 @@ class PatchTable:
         self.rep_v0, self.rep_h0 = Grow((), np.int64), Grow((), np.int64)
         self.rep_F, self.rep_twin = Grow((3,), np.int32), Grow((3,), np.int32)
         self.rep_hs = Grow((3,))
-        self.rep_fs, self.rep_corner = Grow((), np.bool_), Grow((), np.bool_)
+        self.rep_fs = Grow((), np.bool_)
+        self.rep_corner = Grow((), np.float64 if vertex_sharpness else np.bool_)
         self.rep_shape = Grow((3, 2))
         self.parity = Grow((), np.int8)  # per key: 1 when the next step is odd ("sqrt3" only)
         self.nv = Grow((), np.int64)
@@ -181,10 +185,13 @@ class PatchTable:
         the canonical vertex orders: ``vperm``, ``vstart``."""
         fperm, vperm, vstart, rec, norm = canonicalise(level, corner, shape, centre, fstart)
         cv = corner[vperm]
+        if cv.dtype != self.rep_corner.a.dtype:
+            raise AssertionError("corner tags and the table disagree on vertex sharpness")  # pragma: no cover
         h = np.empty((len(centre), 2), np.uint64)  # 128 bits: a collision is not a practical concern
-        key_hashes(rec, fstart, cv.astype(np.int64), vstart, parity, h)
+        bits = cv.view(np.int64) if self.vertex_sharpness else cv.astype(np.int64)  # a sharpness by its bits
+        key_hashes(rec, fstart, bits, vstart, parity, h)
         reg = np.empty(len(centre), np.int8)
-        regular_flags(rec, fstart, cv, vstart, reg)
+        regular_flags(rec, fstart, cv != 0 if self.vertex_sharpness else cv, vstart, reg)
         ids = np.empty(len(centre), np.int64)
         new = []
         for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):

@@ -25,9 +25,9 @@ import scipy.sparse as sp
 from .._input import RefineInput
 from .._topology import Level, child_level, face_parents, plan_step
 from .._refiner import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports, step_matrix
+from .._refiner.loop import next_corners
 from ._descent_kernels import cut_pieces, ring_pairs
-from .local import refine_locally
-from .mask_plan import plan_level
+from .local import plan_vertices, refine_locally
 
 #: Vertex rings of faces around a point's face kept at every level.
 RINGS = 2
@@ -42,7 +42,7 @@ class Patches:
     """All live patches of one level as one mesh of disjoint pieces."""
 
     level: Level
-    corner: np.ndarray  # (n,) bool
+    corner: np.ndarray  # (n,) bool, or each vertex's sharpness left (float64) with semi-sharp corners
     shape: np.ndarray  # (m, 3, 2) every face's corners in its own chart frame
     face: np.ndarray  # (k,) the face holding each node's points
     uv: np.ndarray  # (k, 3, 2) that face's corners in the input face's (u, v)
@@ -73,7 +73,8 @@ def start(inp: RefineInput, faces0: np.ndarray):
     """Level-0 patches around the input faces ``faces0`` (one node each), their selection
     (CSR, patch vertices × input vertices) and where each node's faces start (k + 1,)."""
     node, f = ring_faces(inp.level.faces, inp.n_vertices, faces0)
-    level, corner, vsel, fkeys = cut_patches(inp.level, inp.corner, node, f)
+    vertex_corner = inp.corner if inp.corner_sharpness is None else inp.corner_sharpness
+    level, corner, vsel, fkeys = cut_patches(inp.level, vertex_corner, node, f)
     sel = sp.csr_matrix((np.ones(len(vsel)), vsel, np.arange(len(vsel) + 1)), shape=(len(vsel), inp.n_vertices))
     cur = np.searchsorted(fkeys, np.arange(len(faces0)) * inp.n_faces + faces0)
     shape = np.repeat(EQUILATERAL[None], level.n_faces, axis=0)
@@ -144,7 +145,7 @@ def cut_children(p: Patches, plan, faces1: np.ndarray, child: Level, shapes_of, 
     """The patches (two rings) round the child faces ``centre`` of :func:`refine_patches`'
     step, as a new mesh of disjoint pieces: its :class:`Level`, corner mask, face shapes, each
     piece's centre face, the refined vertex of each new vertex, where each piece's faces start."""
-    corner1 = np.concatenate([p.corner, np.zeros(plan.n_new - p.level.n_vertices, bool)])
+    corner1 = next_corners(p.corner, plan.n_new)  # semi-sharp corners decay by one a level
     node, f = ring_faces(faces1, plan.n_new, centre)
     nxt, corner_n, vsel, fkeys = cut_patches(child, corner1, node, f)
     cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
@@ -165,7 +166,7 @@ def limit_rows(p: Patches, needed: np.ndarray, scheme: str, loop_weights: str, t
     lvl = p.level
     n = lvl.n_vertices
     tagged, esharp = _edge_tags(lvl, scheme)
-    plan = plan_level(lvl, esharp, lvl.face_sharp, p.corner, scheme, loop_weights)
+    plan = plan_vertices(lvl, esharp, lvl.face_sharp, p.corner, scheme, loop_weights)
     L = plan.limit_csr(n, only=needed)
     centers = needed[~plan.pos_ok[needed]]
     if len(centers):

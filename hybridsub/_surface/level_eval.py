@@ -7,8 +7,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from .limit_setup import LimitSetup
-from .local import refine_locally
-from .mask_plan import SEC_TRANSIENT, LimitPlan, plan_level
+from .local import plan_vertices, refine_locally
+from .mask_plan import SEC_TRANSIENT, LimitPlan
 from .normals import sector_normals
 
 
@@ -33,7 +33,7 @@ def evaluate_level(s: LimitSetup, scheme: str, loop_weights: str, X: np.ndarray 
     level = s.level
     n = level.n_vertices
     if plan is None:
-        plan = plan_level(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
+        plan = plan_vertices(level, s.esharp, s.face_sharp, s.corner, scheme, loop_weights)
     nrm = sector_normals(level, plan, X) if X is not None else None
     need = np.zeros(n, dtype=bool)
     if want_rows:

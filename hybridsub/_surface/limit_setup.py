@@ -32,7 +32,7 @@ class LimitInput:
     faces: np.ndarray  # (m, 3) int64 faces of the level evaluated
     n_vertices: int
     face_sharp: np.ndarray  # (m,) sharp (Loop) faces; all of them for "loop"
-    corner: np.ndarray  # (n,) tagged corners
+    corner: np.ndarray  # (n,) tagged corners: a mask, or each vertex's sharpness left (float64, local corners)
     pairs: np.ndarray  # (k, 2) tagged edges of the level evaluated
     sharpness: np.ndarray  # (k,)
     n_keep: int  # vertices of the requested level
@@ -68,19 +68,21 @@ class LimitSetup:
 
 
 def _checked(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights, positions,
-             feature_angle, corner_sharpness, boundary, holes) -> tuple[RefineInput, int]:
+             feature_angle, corner_sharpness, boundary, holes, local_corners) -> tuple[RefineInput, int]:
     """The gate's input, and the level the limit is evaluated at.
 
-    A semi-sharp corner is refined uniformly until its sharpness is spent (⌈s⌉ levels): the
-    masks of the level evaluated then see no finite vertex sharpness, so its limit is that of
-    uniform refinement (the old vertices keep their indices). Kobbelt's boundary rule
-    alternates: √3 is evaluated where the next step is odd.
+    With ``local_corners`` (limit positions and matrices) a semi-sharp corner keeps its
+    sharpness left at the level evaluated (``corner`` is then vertex sharpness): its star
+    alone is refined until the sharpness is spent (:func:`.local.refine_locally`). Without
+    (normals, tangents) the whole mesh is refined uniformly until every sharpness is spent
+    (⌈s⌉ levels), so the masks of the level evaluated see none (the old vertices keep their
+    indices). Kobbelt's boundary rule alternates: √3 is evaluated where the next step is odd.
     """
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights, positions=positions,
                     feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     l_eval = inp.levels
-    if inp.corner_sharpness is not None:
+    if inp.corner_sharpness is not None and not local_corners:
         finite = inp.corner_sharpness[np.isfinite(inp.corner_sharpness)]
         l_eval = max(l_eval, int(np.ceil(finite.max(initial=0.0))))
     l_eval += 1 if scheme == "sqrt3" and l_eval % 2 else 0
@@ -99,15 +101,22 @@ def _face_mask(sharp_faces, m: int, scheme: str) -> np.ndarray:
     return face_sharp
 
 
-def _corner_mask(inp: RefineInput, l_eval: int, n: int) -> np.ndarray:
+def _corner_mask(inp: RefineInput, l_eval: int, n: int, local_corners: bool) -> np.ndarray:
+    """The corners of the level evaluated: a mask, or with ``local_corners`` and semi-sharp
+    corners each vertex's sharpness left (float64: inf a corner, 0 none)."""
+    at, left = _level_corners(inp, l_eval)
+    if local_corners and inp.corner_sharpness is not None:
+        corner = np.zeros(n)
+        corner[at] = np.inf if left is None else left
+        return corner
     corner = np.zeros(n, dtype=bool)
-    corner[_level_corners(inp, l_eval)[0]] = True
+    corner[at] = True
     return corner
 
 
 def refine_for_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
                      positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only",
-                     holes=None) -> LimitInput:
+                     holes=None, local_corners=False) -> LimitInput:
     """Check the input and refine it to the level evaluated, as a :class:`Refinement`
     (``refinement``; see :class:`LimitInput`).
 
@@ -117,19 +126,20 @@ def refine_for_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, shar
     (False, 4, 10)
     """
     inp, l_eval = _checked(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                           positions, feature_angle, corner_sharpness, boundary, holes)
+                           positions, feature_angle, corner_sharpness, boundary, holes, local_corners)
     levels = inp.levels
     r = refinement_of(dataclasses.replace(inp, levels=l_eval))
     faces = np.ascontiguousarray(r.faces, dtype=np.int64)
     out = r.steps[levels - 1].faces if levels else inp.faces
     return LimitInput(faces, r.n_vertices, _face_mask(r.sharp_faces, len(faces), scheme),
-                      _corner_mask(inp, l_eval, r.n_vertices), np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
+                      _corner_mask(inp, l_eval, r.n_vertices, local_corners), np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
                       np.asarray(r.sharpness, np.float64), r.steps[levels - 1].n_vertices if levels else inp.n_vertices,
                       l_eval == levels, scheme, out[kept_faces(r, inp.hole, levels)], refinement=r, hole=inp.hole)
 
 
 def walk_for_limit(V: np.ndarray, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
-                   feature_angle=None, corner_sharpness=None, boundary="edge_only", holes=None) -> LimitInput:
+                   feature_angle=None, corner_sharpness=None, boundary="edge_only", holes=None,
+                   local_corners=False) -> LimitInput:
     """Check the input and refine it with its positions ``V`` (n, 3) float64 to the level
     evaluated, no matrix formed (``X``; see :class:`LimitInput`).
 
@@ -140,13 +150,13 @@ def walk_for_limit(V: np.ndarray, F, sharp_edges, levels, scheme, sharpness, sha
     (False, 4, (10, 3), 3)
     """
     inp, l_eval = _checked(F, sharp_edges, levels, len(V), scheme, sharpness, sharp_faces, corners, loop_weights, V,
-                           feature_angle, corner_sharpness, boundary, holes)
+                           feature_angle, corner_sharpness, boundary, holes, local_corners)
     levels = inp.levels
     w = walk_to(dataclasses.replace(inp, levels=l_eval), V, levels)
     out = w.kept_faces if w.kept_hole is None else w.kept_faces[~w.kept_hole]
     n = len(w.X)
     return LimitInput(np.ascontiguousarray(w.faces, dtype=np.int64), n, _face_mask(w.face_sharp, len(w.faces), scheme),
-                      _corner_mask(inp, l_eval, n), np.asarray(w.sharp_edges, np.int64).reshape(-1, 2),
+                      _corner_mask(inp, l_eval, n, local_corners), np.asarray(w.sharp_edges, np.int64).reshape(-1, 2),
                       np.asarray(w.sharpness, np.float64), w.kept_n_vertices, l_eval == levels, scheme, out, X=w.X,
                       hole=inp.hole)
 
@@ -186,7 +196,7 @@ def local_setup(li: LimitInput, faces: np.ndarray, degree: np.ndarray) -> tuple[
 
 def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
                 positions=None, feature_angle=None, corner_sharpness=None, boundary="edge_only",
-                holes=None) -> LimitSetup:
+                holes=None, local_corners=False) -> LimitSetup:
     """:func:`refine_for_limit` with its halfedges over every face (see :class:`LimitSetup`).
 
     >>> import numpy as np
@@ -195,4 +205,5 @@ def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_fac
     (False, 4, 10)
     """
     return with_halfedges(refine_for_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners,
-                                           loop_weights, positions, feature_angle, corner_sharpness, boundary, holes))
+                                           loop_weights, positions, feature_angle, corner_sharpness, boundary, holes,
+                                           local_corners))

@@ -10,12 +10,14 @@ stars go through ``refine`` together, as one mesh of disjoint pieces.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
+from .._rules.step_rules import child_sharpness
 from .._topology import Level, build_level, halfedge_ends
 from .._refiner import refine
 from .normals import run_estimate, sector_normals
@@ -40,6 +42,32 @@ class _Stars:
     sharpness: np.ndarray
     P: sp.csr_matrix | None  # (n, n0) local vertices over the level-0 vertices (rows wanted)
     X: np.ndarray | None  # (n, 3) local positions, each centre at the origin (normals wanted)
+
+
+def corner_mask(corner: np.ndarray) -> np.ndarray:
+    """A corner mask from a mask or from vertex sharpness (float64: > 0 is a corner now)."""
+    return corner > 0 if corner.dtype == np.float64 else corner
+
+
+def semi_sharp(corner: np.ndarray) -> np.ndarray:
+    """Vertices whose sharpness is finite and not spent (none for a corner mask)."""
+    if corner.dtype != np.float64:
+        return np.zeros(len(corner), dtype=bool)
+    return (corner > 0) & np.isfinite(corner)
+
+
+def plan_vertices(level: Level, esharp, face_sharp, corner: np.ndarray, scheme: str, loop_weights: str) -> LimitPlan:
+    """:func:`plan_level` where ``corner`` may be vertex sharpness (float64): a semi-sharp
+    vertex (finite sharpness left) has no stationary limit mask (it moves once its sharpness is
+    spent), so it is left out of the plan's rows and marked unsettled, to be refined locally."""
+    plan = plan_level(level, esharp, face_sharp, corner_mask(corner), scheme, loop_weights)
+    semi = semi_sharp(corner)
+    if not semi.any():
+        return plan
+    rr, cc, ww = plan.rows
+    keep = ~semi[rr]
+    return dataclasses.replace(plan, pos_ok=plan.pos_ok & ~semi, settled=plan.settled & ~semi,
+                               rows=(rr[keep], cc[keep], ww[keep]))
 
 
 def _cut_stars(level: Level, tagged, face_sharp, centers, sectors0, X, want_rows) -> _Stars:
@@ -87,10 +115,13 @@ def _drop(st: _Stars, active: np.ndarray) -> _Stars:
                   st.P[used] if st.P is not None else None, st.X[used] if st.X is not None else None)
 
 
-def _step(st: _Stars, active, is_corner_c, scheme, loop_weights) -> _Stars:
-    """One step of every star; the new star is the children that touch the centre."""
+def _step(st: _Stars, active, sharp_c, scheme, loop_weights) -> _Stars:
+    """One step of every star; the new star is the children that touch the centre. ``sharp_c``:
+    each centre's vertex sharpness this level (inf: a corner, 0: none)."""
+    c = active & (sharp_c > 0)
     r = refine(st.faces, st.pairs, 1, n_vertices=st.n, scheme=scheme, sharpness=st.sharpness,
-               sharp_faces=st.face_sharp, corners=st.centre[active & is_corner_c], loop_weights=loop_weights)
+               sharp_faces=st.face_sharp, corners=st.centre[c], loop_weights=loop_weights,
+               corner_sharpness=sharp_c[c] if semi_sharp(sharp_c).any() else None)
     s1 = r.steps[0]
     is_c = np.zeros(s1.n_vertices, dtype=bool)
     is_c[st.centre[active]] = True
@@ -113,13 +144,13 @@ def _step(st: _Stars, active, is_corner_c, scheme, loop_weights) -> _Stars:
                   s1.sharpness[ok], P, Xl)
 
 
-def _plan_stars(st: _Stars, active, is_corner_c, scheme, loop_weights) -> tuple[Level, LimitPlan]:
-    """What each centre is now."""
+def _plan_stars(st: _Stars, active, sharp_c, scheme, loop_weights) -> tuple[Level, LimitPlan]:
+    """What each centre is now (``sharp_c``: its vertex sharpness this level)."""
     lvl = build_level(st.faces, st.n)
     _, esh = edge_sharpness(lvl, st.pairs, st.sharpness, scheme)
-    cmask = np.zeros(st.n, dtype=bool)
-    cmask[st.centre[active & is_corner_c]] = True
-    return lvl, plan_level(lvl, esh, st.face_sharp, cmask, scheme, loop_weights)
+    vs = np.zeros(st.n)
+    vs[st.centre[active]] = sharp_c[active]
+    return lvl, plan_vertices(lvl, esh, st.face_sharp, vs, scheme, loop_weights)
 
 
 class _LimitRows:
@@ -233,13 +264,18 @@ def refine_locally(level: Level, tagged, face_sharp, corner, scheme, loop_weight
                    want_rows: bool, tol: float, max_levels: int):
     """Refine the stars of ``centers`` one level at a time with the project's own rules.
 
+    ``corner`` is the corner mask, or each vertex's sharpness (float64: inf a corner, 0 none):
+    a semi-sharp centre keeps its sharpness, decaying by one a level, and has its limit row
+    once the sharpness is spent (only a vertex's own sharpness shapes its star; ``plan0``
+    from :func:`plan_vertices`).
+
     Returns ``(rows, normals)``: the limit rows of the centres (CSR, one row per centre, over
     the input vertices; rows of centres that had a stationary mask are empty) and, for every
     level-0 sector, its normal estimate (zero where it was not asked for).
     """
     nc = len(centers)
     st = _cut_stars(level, tagged, face_sharp, centers, plan0.sectors, X, want_rows)
-    is_corner_c = corner[centers]
+    sharp_c = corner[centers] if corner.dtype == np.float64 else np.where(corner[centers], np.inf, 0.0)
     rows = _LimitRows(~plan0.pos_ok[centers] if want_rows else np.zeros(nc, dtype=bool), level.n_vertices, tol)
     nrm = _SectorNormals(plan0, centers, tol, max_levels) if X is not None else None
     need_nrm = nrm.need if nrm is not None else np.zeros(nc, dtype=bool)
@@ -250,9 +286,10 @@ def refine_locally(level: Level, tagged, face_sharp, corner, scheme, loop_weight
     was_settled = plan0.settled[centers].copy()
     settled_steps = np.zeros(nc, np.int64)
     for lev in range(1, max_levels + 1):
-        st = _step(_drop(st, active), active, is_corner_c, scheme, loop_weights)
+        st = _step(_drop(st, active), active, sharp_c, scheme, loop_weights)
+        sharp_c = child_sharpness(sharp_c)
         settled_steps = np.where(was_settled, settled_steps + 1, 0)
-        lvl, plan = _plan_stars(st, active, is_corner_c, scheme, loop_weights)
+        lvl, plan = _plan_stars(st, active, sharp_c, scheme, loop_weights)
         was_settled = np.zeros(nc, dtype=bool)
         was_settled[active] = plan.settled[st.centre[active]]
         last = lev == max_levels

@@ -117,6 +117,9 @@ def seed_setup(inp: RefineInput) -> SeedMesh:
         face_sharp[:] = True
     corner = np.zeros(n, dtype=bool)
     corner[np.asarray(r.corners, dtype=np.int64)] = True
+    if r.corner_sharpness is not None:  # semi-sharp corners: their sharpness left (refined locally)
+        corner = np.zeros(n)
+        corner[np.asarray(r.corners, dtype=np.int64)] = r.corner_sharpness
     tagged, esharp = edge_sharpness(level, np.asarray(r.sharp_edges, np.int64).reshape(-1, 2),
                                     np.asarray(r.sharpness, np.float64), inp.scheme)
     s = LimitSetup(level, tagged, esharp, face_sharp, corner, r, n, True)

@@ -11,7 +11,7 @@ import scipy.sparse as sp
 
 from .._errors import MeshError
 from .._input import as_vertices, open_gate, writable
-from .._typing import ArrayLike, LoopWeights, MemoryLimit, NonManifold, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .cache import PatchTable
 from .depth import PointDepths
 from .project import closest_points, seed_setup
@@ -74,6 +74,14 @@ class LimitSurface:
         Faces not rendered (:func:`hybridsub.refine`): they shape the surface of their
         neighbours as any face does; :meth:`evaluate` (and :meth:`normals`) on a hole is a
         ``MeshError`` naming the point.
+    corner_sharpness : (c,) array_like of float, optional
+        Sharpness of each of ``corners`` (semi-sharp corners, decaying by one a level), as for
+        :func:`hybridsub.refine`: every point is followed through the refinement with its
+        patch's vertex sharpness, so the surface is that of :func:`hybridsub.subdivide` refined
+        forever (its limit points are :func:`hybridsub.limit_positions`').
+    boundary : {"edge_only", "edge_and_corner", "none"}
+        OpenSubdiv's boundary interpolation, as for :func:`hybridsub.refine`; with ``"none"``
+        the faces at the boundary are holes (evaluating them is a ``MeshError``).
 
     Notes
     -----
@@ -100,12 +108,13 @@ class LimitSurface:
                  scheme: Scheme = "hybrid", sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                  corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                  feature_angle: float | None = None, non_manifold: NonManifold = "raise",
-                 max_memory: MemoryLimit = None, depth: int | None = None, holes: ArrayLike | None = None):
+                 max_memory: MemoryLimit = None, depth: int | None = None, holes: ArrayLike | None = None,
+                 corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only"):
         X = as_vertices(V)
         inp = open_gate(F, sharp_edges, 0, n_vertices=len(X), scheme=scheme, sharpness=sharpness,
                         sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
                         non_manifold=non_manifold, max_memory=max_memory, positions=X, feature_angle=feature_angle,
-                        holes=holes)
+                        holes=holes, corner_sharpness=corner_sharpness, boundary=boundary)
         self._hole = inp.hole  # (m,) bool or None: evaluate refuses these faces
         self._faces_in, self._copy = inp.faces, None
         if inp.cut is not None:  # the surface of the cut mesh (a manifold input), over the caller's vertices
@@ -173,7 +182,8 @@ class LimitSurface:
 
     def _new_cache(self):
         """An empty patch cache (``_surface/cache.py``): filled as points are evaluated."""
-        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels)
+        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels,
+                                 vertex_sharpness=self._inp.corner_sharpness is not None)
         self._starts = StartKeys(self._inp, self._table)
 
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):

@@ -22,7 +22,7 @@ from .._topology._kernels import use_threads
 from . import _vertex_kernels as VK
 from .limit_setup import LimitInput, local_setup
 from .level_eval import evaluate_level
-from .mask_plan import plan_level
+from .local import plan_vertices
 from .normals import one_side_sectors, sector_normals, vertex_normals
 
 #: Valences the kernel's tables cover; a vertex of higher valence takes the general plan.
@@ -58,7 +58,7 @@ def _blocked(li: LimitInput) -> np.ndarray:
         return blocked
     pairs, sharpness = li.tag_pairs()
     blocked[pairs[sharpness > 0].ravel()] = True
-    return blocked | li.corner
+    return blocked | (li.corner > 0)
 
 
 def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_positions: bool, want_normals: bool,
@@ -97,7 +97,7 @@ def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_position
         g = np.searchsorted(used, G)
         at_g = np.zeros(len(used), dtype=bool)
         at_g[g] = True
-        plan = plan_level(sub.level, sub.esharp, sub.face_sharp, sub.corner, li.scheme, loop_weights)
+        plan = plan_vertices(sub.level, sub.esharp, sub.face_sharp, sub.corner, li.scheme, loop_weights)
         if want_positions:
             L, _, _ = evaluate_level(sub, li.scheme, loop_weights, None, True, tol, max_levels, only=at_g, plan=plan)
             P[G] = L[g] @ Xs

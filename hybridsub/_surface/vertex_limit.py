@@ -101,7 +101,7 @@ def limit_matrix(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, levels: 
         n_vertices = len(Vf)
     s = setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
                     positions=Vf, feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary,
-                    holes=holes)
+                    holes=holes, local_corners=True)
     r = s.refinement
     if s.level is None:
         L = sp.identity(r.n_vertices, format="csr")
@@ -151,7 +151,8 @@ def limit_positions(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
     li = walk_for_limit(Vf, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
-                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
+                        local_corners=True)
     P, _ = _level_limits(li, Vf, loop_weights, True, False, "average", tol, tol, max_levels)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
     return np.ascontiguousarray(P[: li.n_keep], dtype=out_dtype)
@@ -324,7 +325,8 @@ def limit_mesh(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None,
     tol, max_levels = _check_tol(tol, max_levels)
     normal_tol, _ = _check_tol(normal_tol, max_levels)
     li = walk_for_limit(Vf, F, sharp_edges, levels, scheme, sharpness, sharp_faces, corners, loop_weights,
-                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+                        feature_angle=feature_angle, corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
+                        local_corners=not normals)
     P, N = _level_limits(li, Vf, loop_weights, True, bool(normals), crease_normals, tol, normal_tol, max_levels)
     out_dtype = A.dtype if np.issubdtype(A.dtype, np.floating) else np.float64
     return LimitMesh(np.ascontiguousarray(P[: li.n_keep], dtype=out_dtype), li.out_faces,

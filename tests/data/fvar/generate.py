@@ -2,15 +2,19 @@
 
     benchmarks/peers/build.sh && python tests/data/fvar/generate.py
 
-The input is the textured bunny scan of ``../bunny10k_textured.fvar_linear.L1.npz``
-(``V_in, F_in, UV_in, FUV_in``; no creases). ``benchmarks/peers/osd_fvar`` refines it
-uniformly with Far (Loop, ``VTX_BOUNDARY_EDGE_ONLY``) and each ``FVarLinearInterpolation``
-mode, at levels 1 and 2. Written here:
+The input is a part of the textured bunny scan of ``../bunny10k_textured.fvar_linear.L1.npz``
+(``V_in, F_in, UV_in, FUV_in``; no creases): the faces within ``RINGS`` rings of ``SEEDS``,
+the scan's three vertices whose UV indices alternate p, q, p, q around them, where OpenSubdiv
+gives a UV index a value of its own (``test_face_varying.alternating_uvs``; the only places
+where a mode disagrees with hybridsub), so that the part holds every disagreement of the
+whole scan, besides UV seams and the part's own boundary. ``benchmarks/peers/osd_fvar``
+refines it uniformly with Far (Loop, ``VTX_BOUNDARY_EDGE_ONLY``) and each
+``FVarLinearInterpolation`` mode, at levels 1 and 2. Written here (compressed):
 
-- ``bunny10k_textured.input.npz``: ``V_in, F_in, UV_in, FUV_in``;
-- ``bunny10k_textured.L{1,2}.npz``: OpenSubdiv's refined ``V, F`` and ``FUV`` (its UV index
+- ``bunny_seams.input.npz``: ``V_in, F_in, UV_in, FUV_in``;
+- ``bunny_seams.L{1,2}.npz``: OpenSubdiv's refined ``V, F`` and ``FUV`` (its UV index
   of each face corner; the same in every mode, which this script checks);
-- ``bunny10k_textured.{mode}.L{1,2}.npz``: ``UV``, the refined UV values of ``mode``
+- ``bunny_seams.{mode}.L{1,2}.npz``: ``UV``, the refined UV values of ``mode``
   (``none``, ``corners_only``, ``corners_plus1``, ``corners_plus2``, ``boundaries``, ``all``),
   and ``note``.
 
@@ -27,6 +31,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 BIN = os.path.join(ROOT, "benchmarks", "peers", "bin", "osd_fvar")
+NAME = "bunny_seams"
+SEEDS = (1409, 3160, 3403)  # vertices of the scan (see the module doc)
+RINGS = 4
 MODES = ("none", "corners_only", "corners_plus1", "corners_plus2", "boundaries", "all")
 OSD_NAMES = dict(none="FVAR_LINEAR_NONE", corners_only="FVAR_LINEAR_CORNERS_ONLY",
                  corners_plus1="FVAR_LINEAR_CORNERS_PLUS1", corners_plus2="FVAR_LINEAR_CORNERS_PLUS2",
@@ -61,12 +68,26 @@ def read_output(prefix):
     return V, F, UV, FUV
 
 
+def part(V, F, UV, FUV):
+    """The faces within ``RINGS`` rings of ``SEEDS`` (the first ring: the faces at a seed; a face
+    is in the next ring when it shares a vertex with the current part), their vertices and UV
+    values renumbered in order."""
+    keep = np.isin(F, SEEDS).any(axis=1)
+    for _ in range(RINGS - 1):
+        on = np.zeros(len(V), bool)
+        on[F[keep].ravel()] = True
+        keep = on[F].any(axis=1)
+    used, Fp = np.unique(F[keep], return_inverse=True)
+    uvs, FUVp = np.unique(FUV[keep], return_inverse=True)
+    return V[used], Fp.reshape(-1, 3), UV[uvs], FUVp.reshape(-1, 3)
+
+
 def main():
     if not os.path.exists(BIN):
         sys.exit(f"{BIN} not built: run benchmarks/peers/build.sh")
     d = np.load(os.path.join(HERE, "..", "bunny10k_textured.fvar_linear.L1.npz"))
-    V, F, UV, FUV = (d[k] for k in ("V_in", "F_in", "UV_in", "FUV_in"))
-    np.savez_compressed(os.path.join(HERE, "bunny10k_textured.input.npz"), V_in=V, F_in=F, UV_in=UV, FUV_in=FUV)
+    V, F, UV, FUV = part(*(d[k] for k in ("V_in", "F_in", "UV_in", "FUV_in")))
+    np.savez_compressed(os.path.join(HERE, f"{NAME}.input.npz"), V_in=V, F_in=F, UV_in=UV, FUV_in=FUV)
     with tempfile.TemporaryDirectory() as tmp:
         off, uvs = write_input(tmp, V, F, UV, FUV)
         for levels in (1, 2):
@@ -77,14 +98,14 @@ def main():
                 V2, F2, UV2, FUV2 = read_output(prefix)
                 if geometry is None:
                     geometry = (V2, F2, FUV2)
-                    np.savez_compressed(os.path.join(HERE, f"bunny10k_textured.L{levels}.npz"), V=V2,
+                    np.savez_compressed(os.path.join(HERE, f"{NAME}.L{levels}.npz"), V=V2,
                                         F=F2.astype(np.int32), FUV=FUV2.astype(np.int32))
                 elif not (np.array_equal(geometry[0], V2) and np.array_equal(geometry[1], F2)
                           and np.array_equal(geometry[2], FUV2)):
                     sys.exit(f"{mode} L{levels}: OpenSubdiv's faces or UV indices differ between modes")
                 note = (f"OpenSubdiv 3.5 Far, Loop, VTX_BOUNDARY_EDGE_ONLY, face-varying channel with "
                         f"{OSD_NAMES[mode]}, {levels} levels (tests/data/fvar/generate.py)")
-                np.savez_compressed(os.path.join(HERE, f"bunny10k_textured.{mode}.L{levels}.npz"), UV=UV2,
+                np.savez_compressed(os.path.join(HERE, f"{NAME}.{mode}.L{levels}.npz"), UV=UV2,
                                     note=note)
                 print(f"{mode} L{levels}: {len(UV2)} UV values")
 
