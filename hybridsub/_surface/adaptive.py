@@ -17,7 +17,7 @@ import numpy as np
 from .._input import RefineInput, as_vertices, open_gate
 from .._refiner import FaceCharts, Refinement, refine
 from .._refiner.chart import best_held_corners
-from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement, refine_region
+from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, LoopWeights, Scheme
 from .mask_plan import plan_level
@@ -90,6 +90,14 @@ def _closed_for_sqrt3(inp: RefineInput) -> None:
                          'whose boundary is a crease')
 
 
+def spread_one_ring(mesh: AdaptiveMesh, want: np.ndarray) -> np.ndarray:
+    """Each face's wanted level raised to the largest wanted level of the faces that share a
+    vertex with it."""
+    at_v = np.zeros(mesh.n_vertices, np.int64)
+    np.maximum.at(at_v, mesh.faces.ravel(), np.repeat(want, 3))
+    return np.maximum(want, at_v[mesh.faces].max(axis=1))
+
+
 class Criterion:
     """The error criterion, called by the driver at every level (see ``OnLevel``).
 
@@ -106,7 +114,6 @@ class Criterion:
         self.P = X.copy()  # level positions
         self.Q = X.copy()  # output positions: limit positions where known
         self.known = np.zeros(len(X), bool)
-        self.prev = None  # the previous level: (mesh, active, k, positions)
         self.error = np.zeros(inp.n_faces)
         self.done = np.zeros(inp.n_faces, bool)
 
@@ -131,15 +138,18 @@ class Criterion:
             self.done = self.done[step.face_parent] & (mesh.face_level < k)
         fresh = np.flatnonzero(~self.done)
         self._mask_pass(mesh, active)
-        self.error[fresh] = self._errors(mesh, fresh, step)
+        self.error[fresh] = self._errors(mesh, fresh)
         self.done[fresh] = True
         want = np.zeros(len(mesh.faces), np.int64)
         over = self.error > self.tol
         rate = np.where(mesh.face_sharp, RATE[True], RATE[False])
         more = np.ceil(np.log(self.error[over] / self.tol) / np.log(rate[over])).astype(np.int64)
         want[over] = mesh.face_level[over] + np.maximum(more, 1)
-        self.prev = (mesh, active, k, self.P)
-        return want
+        # The faces round a face over the tolerance are wanted at its level too, so that the
+        # closure faces at the region's border are made in faces that are within the tolerance
+        # already: a closure face is never refined again, and one over the tolerance would make
+        # the driver start again with a wider margin (adaptive_refinement).
+        return spread_one_ring(mesh, want)
 
     def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, P: np.ndarray, todo: np.ndarray):
         """Limit positions by the stationary limit masks (those of ``limit_positions``) of the
@@ -188,48 +198,12 @@ class Criterion:
         self.Q[v] = q
         self.known[v] = True
 
-    def _virtual_pass(self, step: RegionStep, need: np.ndarray) -> np.ndarray:
-        """Limit positions of ``need`` (vertices of this level whose ring here is not complete)
-        from the uniform step of every active face of the previous level, made aside: there
-        their rings are complete more often. Returns the vertices still without one."""
-        if self.prev is None or not len(need):
-            return need
-        pm, pa, pk, PP = self.prev
-        if not pa.any():
-            return need
-        vm, vst = refine_region(pm, pa, pk, "hybrid" if self.inp.scheme == "sqrt3" else self.inp.scheme,
-                                self.inp.loop_weights)
-        n0 = pm.n_vertices
-        todo = np.zeros(vm.n_vertices, bool)
-        # Each vertex of this level in the aside step: old ones by index, new ones by what made them.
-        where = np.full(len(need), -1, np.int64)
-        old = need < n0
-        where[old] = need[old]
-        order = np.argsort(vst.source)
-        keys = vst.source[order]
-        k = step.source[need[~old] - n0]
-        at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
-        hit = keys[at] == k
-        idx = np.flatnonzero(~old)
-        where[idx[hit]] = n0 + order[at[hit]]
-        found = where >= 0
-        todo[where[found]] = True
-        v, q = self._masked_limits(vm, vm.active(pk + 1), vst.matrix @ PP, todo)
-        got = np.full(vm.n_vertices, -1, np.int64)
-        got[v] = np.arange(len(v))
-        ok = found & (got[np.maximum(where, 0)] >= 0)
-        self.Q[need[ok]] = q[got[where[ok]]]
-        self.known[need[ok]] = True
-        return need[~ok]
-
-    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray, step: RegionStep | None) -> np.ndarray:
+    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray) -> np.ndarray:
         """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
         once) and its centroid against the surface."""
         F = mesh.faces
         need = np.unique(F[fresh].ravel())
         need = need[~self.known[need]]
-        if step is not None:
-            need = self._virtual_pass(step, need)
         if len(need):
             self._limits(mesh, fresh, need)
         out = self.Q if self.limit else self.P
