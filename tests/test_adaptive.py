@@ -59,8 +59,13 @@ def uniform_match(V, F, tags, scheme, r, X):
     index = np.full(len(X), -1, np.int64)
     apart = 10.0 * (diagonal(V) + 1.0)
     piece = _piece_of_vertices(F, r.faces, r.face_parent, len(X))
+    # Holes hide faces and leave the refinement as it is: the uniform vertices' pieces are
+    # those of the whole refinement, and a vertex only hidden faces use is not matched.
+    tags = {k: v for k, v in tags.items() if k != "holes"}
+    if tags.get("boundary") == "none":
+        tags["boundary"] = "edge_only"
     for j in range(top + 1):
-        sel = np.flatnonzero(r.vertex_level == j)
+        sel = np.flatnonzero((r.vertex_level == j) & (piece >= 0))
         if not len(sel):
             continue
         if j:
@@ -123,6 +128,87 @@ def test_region_refinement_is_crack_free_and_exact(mesh, data):
     # The faces asked for are refined `levels` times.
     assert (r.face_level[where[r.face_parent]] == levels).all()
     assert r.face_level.max(initial=0) <= levels
+
+
+def _options(data, V, F, tags, scheme):
+    """corner_sharpness (finite or infinite per corner), boundary and holes, drawn."""
+    tags = dict(tags)
+    if tags.get("corners") is not None and len(tags["corners"]) and scheme != "sqrt3":
+        cs = data.draw(st.lists(st.sampled_from([0.5, 1.0, 1.5, 2.5, np.inf]), min_size=len(tags["corners"]),
+                                max_size=len(tags["corners"])))
+        tags["corner_sharpness"] = np.array(cs)
+    tags["boundary"] = data.draw(st.sampled_from(["edge_only", "edge_and_corner", "none"]))
+    if data.draw(st.booleans()):
+        tags["holes"] = np.flatnonzero(np.random.default_rng(len(F)).random(len(F)) < 0.1)
+    return tags
+
+
+@cfg(30)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_region_refinement_with_options_is_exact(mesh, data):
+    # corner_sharpness, boundary and holes as refine takes them: every vertex is the uniform
+    # refinement's (with the same options) at its level; the holes' descendants left out.
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
+    if scheme == "sqrt3":
+        if len(ms.boundary_edges(F)):
+            scheme = "hybrid"
+        else:
+            tags = {}
+    tags = _options(data, V, F, tags, scheme)
+    levels = data.draw(st.integers(1, 3 if len(F) <= 40 else 2))
+    where = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1))).random(len(F)) < 0.3
+    r = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme=scheme, n_vertices=len(V), **tags)
+    uniform_match(V, F, tags, scheme, r, r.apply(V))
+    # Holes (and boundary="none"'s) leave the refinement as it is and hide faces, as refine does.
+    shown = {k: v for k, v in tags.items() if k != "holes"}
+    if shown["boundary"] == "none":
+        shown["boundary"] = "edge_only"
+    full = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme=scheme, n_vertices=len(V), **shown)
+    assert np.array_equal(r.apply(V), full.apply(V))
+    hidden = np.ones(len(F), bool)
+    hidden[hybridsub.refine(F, levels=1, scheme=scheme, n_vertices=len(V), **tags).face_parent] = False
+    assert np.array_equal(r.faces, full.faces[~hidden[full.face_parent]])
+    assert (r.face_level[where[r.face_parent]] == levels).all()
+    # The corners (with boundary="edge_and_corner" also its own) and the sharpness left to
+    # each at its level, as refine gives them at that level.
+    u0 = hybridsub.refine(F, levels=0, scheme=scheme, n_vertices=len(V), **tags)
+    cs = np.zeros(len(V))
+    cs[u0.corners] = np.inf if u0.corner_sharpness is None else u0.corner_sharpness
+    left = np.where(np.isinf(cs), cs, np.maximum(cs - r.vertex_level[:len(V)], 0))
+    assert np.array_equal(np.sort(r.corners), np.flatnonzero(left > 0))
+    if r.corner_sharpness is not None:
+        assert np.array_equal(r.corner_sharpness, left[r.corners])
+
+
+def test_tolerance_with_boundary_and_holes():
+    I, J = np.meshgrid(np.arange(7), np.arange(7), indexing="ij")
+    V, F = ms.grid(6, 6, (I[:6, :6] + J[:6, :6]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
+    holes = [3, 17]
+    for boundary in ("edge_only", "edge_and_corner", "none"):
+        tags = dict(boundary=boundary, holes=holes)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = hybridsub.refine_adaptive(F, V=V, tolerance="0.5%", scheme="loop", **tags)
+            V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.5%", scheme="loop", **tags)
+        assert np.array_equal(F2, r.faces)
+        index = uniform_match(V, F, tags, "loop", r, r.apply(V))
+        used = np.isin(np.arange(r.n_vertices), F2)
+        for j in range(int(r.vertex_level.max()) + 1):
+            sel = np.flatnonzero((r.vertex_level == j) & used)
+            L = hybridsub.limit_positions(V, F, levels=j, scheme="loop", **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max(initial=0) <= 1e-9, (boundary, j, d.max())
+        u = hybridsub.refine(F, levels=1, scheme="loop", **tags)
+        assert np.array_equal(np.unique(r.face_parent), np.unique(u.face_parent))  # holes left out
+
+
+def test_tolerance_refuses_semi_sharp_corners():
+    V, F = ms.icosahedron()
+    with pytest.raises(ValueError, match="semi-sharp corners"):
+        hybridsub.subdivide_adaptive(V, F, tolerance="1%", corners=[0], corner_sharpness=[1.5])
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="2%", corners=[0], corner_sharpness=[np.inf])
+    assert np.allclose(V2[0], V[0])
 
 
 @pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
-from .._refiner import FaceCharts, Refinement, refine
+from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
-from .._typing import ArrayLike, LoopWeights, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
 from .mask_plan import plan_level
 from .surface import LimitSurface
 from .vertex_limit import limit_positions
@@ -137,6 +137,11 @@ class Criterion:
             self.error = self.error[step.face_parent]
             self.done = self.done[step.face_parent] & (mesh.face_level < k)
         fresh = np.flatnonzero(~self.done)
+        if self.inp.hole is not None:  # faces not rendered: not measured (error 0)
+            hidden = self.inp.hole[mesh.face_parent[fresh]]
+            self.error[fresh[hidden]] = 0.0
+            self.done[fresh[hidden]] = True
+            fresh = fresh[~hidden]
         self._mask_pass(mesh, active)
         self.error[fresh] = self._errors(mesh, fresh)
         self.done[fresh] = True
@@ -270,26 +275,31 @@ def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, l
 
     run = adaptive_refinement(inp, np.zeros(inp.n_faces, np.int64), max_levels, on_level)
     c = holder.get("c")
+    refinement = without_holes(run.refinement, inp.hole)
     if c is None:  # no faces
-        return AdaptiveResult(run.refinement, X.copy(), 0.0, tol)
+        return AdaptiveResult(refinement, X.copy(), 0.0, tol)
     P = c.positions(run.mesh)
     err = float(c.error.max(initial=0.0))
     if err > tol:
         warnings.warn(f"tolerance {tol:.6g} not reached in max_levels={max_levels} levels: the largest error is "
                       f"{err:.6g} ({err / tol:.3g}× the tolerance); raise max_levels to go further",
                       AdaptiveWarning, stacklevel=4)
-    return AdaptiveResult(run.refinement, P, err, tol)
+    return AdaptiveResult(refinement, P, err, tol)
 
 
 def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, tolerance,
                     max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop") -> AdaptiveResult:
+                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                    corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                    holes: ArrayLike | None = None) -> AdaptiveResult:
     """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
     command line)."""
     X = as_vertices(V)
     ml = _max_levels(max_levels)
-    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
+    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights,
+                corner_sharpness, boundary, holes)
+    _no_semi_sharp_corners(inp)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
 
@@ -314,11 +324,20 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
     return float(np.linalg.norm(S - T, axis=2).max(initial=0.0))
 
 
-def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights) -> RefineInput:
+def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+          corner_sharpness=None, boundary="edge_only", holes=None) -> RefineInput:
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
-                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     _closed_for_sqrt3(inp)
     return inp
+
+
+def _no_semi_sharp_corners(inp: RefineInput) -> None:
+    if inp.corner_sharpness is not None:
+        raise ValueError("a tolerance with semi-sharp corners (finite corner_sharpness) is not supported yet: the "
+                         "limit surface the error is measured against does not take them; refine a region "
+                         "(where=, levels=) or give the corners infinite sharpness")
 
 
 def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where: ArrayLike | None = None,
@@ -326,7 +345,8 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
                     max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
-                    n_vertices: int | None = None) -> Refinement:
+                    n_vertices: int | None = None, corner_sharpness: ArrayLike | None = None,
+                    boundary: Boundary = "edge_only", holes: ArrayLike | None = None) -> Refinement:
     """Refine only where it matters: a region to a level, or everywhere to a tolerance.
 
     Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
@@ -343,6 +363,10 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
     ----------
     F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, n_vertices
         As for :func:`hybridsub.refine` (checked the same way). ``"sqrt3"`` needs a closed mesh.
+    corner_sharpness, boundary, holes
+        As for :func:`hybridsub.refine`: semi-sharp corners (only with ``where=``: the error
+        criterion does not take them yet), OpenSubdiv's boundary interpolation, and faces left
+        out of ``faces`` (those descending from a hole; a hole is not measured by ``tolerance``).
     where : (m,) bool mask or array_like of int
         The input faces to refine ``levels`` times.
     levels : int
@@ -382,20 +406,24 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         X = as_vertices(V)
         ml = _max_levels(max_levels)
         inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
-                    sharp_faces, corners, loop_weights)
+                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes)
+        _no_semi_sharp_corners(inp)
         return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
     if levels is None:
         raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
-    inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+    inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+                corner_sharpness, boundary, holes)
     mask = _where_mask(where, inp.n_faces)
-    return adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels).refinement
+    run = adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels)
+    return without_holes(run.refinement, inp.hole)
 
 
 def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *,
                        tolerance: float | str, max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                        sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-                       corners: ArrayLike | None = None,
-                       loop_weights: LoopWeights = "loop") -> tuple[np.ndarray, np.ndarray]:
+                       corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                       corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                       holes: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Subdivide until the mesh is within ``tolerance`` of the limit surface, only where needed.
 
     Each face is refined until the largest distance between it and the limit surface over it,
@@ -408,8 +436,10 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     Parameters
     ----------
     V : (n, 3) array_like of float
-    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
-        As for :func:`hybridsub.subdivide`.
+    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, boundary, holes
+        As for :func:`hybridsub.subdivide` (holes: left out of ``F2`` and not measured).
+    corner_sharpness
+        Infinite values only (semi-sharp corners are not supported with a tolerance yet).
     tolerance : float or str
         In mesh units, or a string such as ``"0.1%"`` of the bounding-box diagonal.
     max_levels : int
@@ -433,5 +463,6 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     (3, 3)
     """
     res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
-                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                          corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
     return res.positions.copy(), res.refinement.faces.copy()
