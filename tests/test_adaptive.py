@@ -203,6 +203,46 @@ def test_tolerance_with_boundary_and_holes():
         assert np.array_equal(np.unique(r.face_parent), np.unique(u.face_parent))  # holes left out
 
 
+def _book(n=4):
+    """Three bumpy sheets sharing a row of edges (each of them in three faces)."""
+    I, J = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    G, Fg = ms.grid(n, n, (I[:n, :n] + J[:n, :n]) % 2 == 0)
+    x, y = G[:, 0], G[:, 1]
+    sheets = [np.column_stack([x, y, 0.2 * np.sin(x) * y]), np.column_stack([x, 0 * y, y + 0.1 * x * y]),
+              np.column_stack([x, 0 * y, -y])]
+    V = np.vstack(sheets)
+    F = np.vstack([Fg, Fg + len(G), Fg[:, ::-1] + 2 * len(G)])
+    _, first, inv = np.unique(np.round(V, 9), axis=0, return_index=True, return_inverse=True)
+    return V[first], inv.ravel()[F]
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_non_manifold_cut_is_exact(scheme):
+    # non_manifold="cut" as refine takes it: the region's vertices are the uniform refinement's
+    # of the cut copy; to a tolerance, at the cut copy's limit positions.
+    V, F = _book()
+    tags = dict(non_manifold="cut", sharp_edges=F[:2, :2])
+    with pytest.raises(hybridsub.MeshError):
+        hybridsub.refine_adaptive(F, where=[0], levels=1, scheme=scheme)
+    r = hybridsub.refine_adaptive(F, where=np.arange(12), levels=2, scheme=scheme, **tags)
+    uniform_match(V, F, tags, scheme, r, r.apply(V))
+    assert r.face_level.max() == 2 and r.face_level.min() == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    from hybridsub._input import open_gate
+    cut = open_gate(F, tags["sharp_edges"], 0, scheme=scheme, non_manifold="cut")  # the cut copy
+    for j in range(int(r.vertex_level.max()) + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        L = hybridsub.limit_positions(V[cut.cut.origin], cut.faces, cut.sharp_edges, levels=j, scheme=scheme,
+                                      corners=np.flatnonzero(cut.corner))
+        d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+        assert d.max(initial=0) <= 1e-9, (j, d.max())
+
+
 def test_tolerance_refuses_semi_sharp_corners():
     V, F = ms.icosahedron()
     with pytest.raises(ValueError, match="semi-sharp corners"):

@@ -39,7 +39,7 @@ import scipy.sparse as sp
 
 from .._input import RefineInput
 from .._topology import Level, build_level, child_level, plan_step
-from .refinement import Refinement, RefinementStep
+from .refinement import Refinement, RefinementStep, _compose_cut
 from .stencils import step_matrix
 
 
@@ -317,8 +317,10 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
     face_parent = mesh.face_parent.copy()
     corners_out, corner_sharpness = corners_left(mesh)
     r = Refinement(mesh.faces, pairs, sharp, inp.faces_out(mesh.face_sharp), corners_out, face_parent, steps,
-                   inp.n_vertices, inp.max_memory, None, coarse_faces=inp.faces, face_level=mesh.face_level.copy(),
-                   vertex_level=mesh.vertex_level.copy(), corner_sharpness=corner_sharpness)
+                   inp.n_vertices, inp.max_memory, None, coarse_faces=inp.faces if inp.cut is None else None,
+                   face_level=mesh.face_level.copy(), vertex_level=mesh.vertex_level.copy(),
+                   corner_sharpness=corner_sharpness)
+    r = _compose_cut(inp, r)  # non_manifold="cut": the first step takes the caller's vertices
     cat = (lambda a: np.concatenate(a) if a else np.empty(0, np.int64))
     return AdaptiveRun(r, cat(missed), cat(missed_level), mesh)
 

@@ -19,7 +19,7 @@ from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
-from .._typing import ArrayLike, Boundary, LoopWeights, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, NonManifold, Scheme
 from .mask_plan import plan_level
 from .surface import LimitSurface
 from .vertex_limit import limit_positions
@@ -263,9 +263,16 @@ class AdaptiveResult:
 
 def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, limit: bool) -> AdaptiveResult:
     tol = tolerance_of(tolerance, X)
-    surface = LimitSurface(X, inp.faces, inp.sharp_edges, scheme=inp.scheme, sharpness=inp.sharpness,
-                           sharp_faces=inp.face_sharp if inp.scheme == "hybrid" else None,
-                           corners=np.flatnonzero(inp.corner), loop_weights=inp.loop_weights)
+    sharp_faces = inp.face_sharp if inp.scheme == "hybrid" else None
+    if inp.cut is None:
+        surface = LimitSurface(X, inp.faces, inp.sharp_edges, scheme=inp.scheme, sharpness=inp.sharpness,
+                               sharp_faces=sharp_faces, corners=np.flatnonzero(inp.corner), loop_weights=inp.loop_weights)
+    else:  # the caller's mesh, cut as the gate cut it; the criterion follows the cut copy's vertices
+        u = inp.uncut
+        surface = LimitSurface(X, u.faces, u.sharp_edges, scheme=inp.scheme, sharpness=u.sharpness,
+                               sharp_faces=sharp_faces, corners=np.flatnonzero(u.corner),
+                               loop_weights=inp.loop_weights, non_manifold="cut")
+        X = X[inp.cut.origin]
     holder = {}
 
     def on_level(k, mesh, active, step):
@@ -292,13 +299,13 @@ def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
-                    holes: ArrayLike | None = None) -> AdaptiveResult:
+                    holes: ArrayLike | None = None, non_manifold: NonManifold = "raise") -> AdaptiveResult:
     """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
     command line)."""
     X = as_vertices(V)
     ml = _max_levels(max_levels)
     inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes)
+                corner_sharpness, boundary, holes, non_manifold)
     _no_semi_sharp_corners(inp)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
@@ -325,10 +332,10 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-          corner_sharpness=None, boundary="edge_only", holes=None) -> RefineInput:
+          corner_sharpness=None, boundary="edge_only", holes=None, non_manifold="raise") -> RefineInput:
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold)
     _closed_for_sqrt3(inp)
     return inp
 
@@ -346,7 +353,8 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     n_vertices: int | None = None, corner_sharpness: ArrayLike | None = None,
-                    boundary: Boundary = "edge_only", holes: ArrayLike | None = None) -> Refinement:
+                    boundary: Boundary = "edge_only", holes: ArrayLike | None = None,
+                    non_manifold: NonManifold = "raise") -> Refinement:
     """Refine only where it matters: a region to a level, or everywhere to a tolerance.
 
     Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
@@ -363,10 +371,11 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
     ----------
     F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, n_vertices
         As for :func:`hybridsub.refine` (checked the same way). ``"sqrt3"`` needs a closed mesh.
-    corner_sharpness, boundary, holes
+    corner_sharpness, boundary, holes, non_manifold
         As for :func:`hybridsub.refine`: semi-sharp corners (only with ``where=``: the error
-        criterion does not take them yet), OpenSubdiv's boundary interpolation, and faces left
-        out of ``faces`` (those descending from a hole; a hole is not measured by ``tolerance``).
+        criterion does not take them yet), OpenSubdiv's boundary interpolation, faces left
+        out of ``faces`` (those descending from a hole; a hole is not measured by ``tolerance``)
+        and ``"cut"``: a non-manifold input refined as its manifold cut copy.
     where : (m,) bool mask or array_like of int
         The input faces to refine ``levels`` times.
     levels : int
@@ -406,13 +415,13 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         X = as_vertices(V)
         ml = _max_levels(max_levels)
         inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
-                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes)
+                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold)
         _no_semi_sharp_corners(inp)
         return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
     if levels is None:
         raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
     inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes)
+                corner_sharpness, boundary, holes, non_manifold)
     mask = _where_mask(where, inp.n_faces)
     run = adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels)
     return without_holes(run.refinement, inp.hole)
@@ -423,7 +432,8 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
                        sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                        corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                        corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
-                       holes: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+                       holes: ArrayLike | None = None,
+                       non_manifold: NonManifold = "raise") -> tuple[np.ndarray, np.ndarray]:
     """Subdivide until the mesh is within ``tolerance`` of the limit surface, only where needed.
 
     Each face is refined until the largest distance between it and the limit surface over it,
@@ -436,8 +446,9 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     Parameters
     ----------
     V : (n, 3) array_like of float
-    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, boundary, holes
-        As for :func:`hybridsub.subdivide` (holes: left out of ``F2`` and not measured).
+    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, boundary, holes, non_manifold
+        As for :func:`hybridsub.subdivide` (holes: left out of ``F2`` and not measured; with
+        ``"cut"`` the output is the refined cut copy, its cut vertices apart).
     corner_sharpness
         Infinite values only (semi-sharp corners are not supported with a tolerance yet).
     tolerance : float or str
@@ -464,5 +475,6 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     """
     res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
                           sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                          corner_sharpness=corner_sharpness, boundary=boundary, holes=holes)
+                          corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
+                          non_manifold=non_manifold)
     return res.positions.copy(), res.refinement.faces.copy()
