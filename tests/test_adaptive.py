@@ -445,6 +445,21 @@ def test_cli_subdivide_to_a_tolerance(tmp_path, capsys):
         assert e.value.code == 2
 
 
+def test_cli_tolerance_takes_boundary(tmp_path, capsys):
+    from hybridsub._app.cli import main
+    I, J = np.meshgrid(np.arange(6), np.arange(6), indexing="ij")
+    V, F = ms.grid(5, 5, (I[:5, :5] + J[:5, :5]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
+    src, out = tmp_path / "g.obj", tmp_path / "a.obj"
+    hybridsub.write_mesh(str(src), V, F)
+    assert main(["subdivide", str(src), "-o", str(out), "--tolerance", "1%", "--boundary", "edge_and_corner",
+                 "--scheme", "loop"]) == 0
+    m = hybridsub.read_mesh(str(out))
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="1%", boundary="edge_and_corner", scheme="loop")
+    assert np.array_equal(m.faces, F2) and np.allclose(m.vertices, V2, atol=1e-9)
+    Va, Fa = hybridsub.subdivide_adaptive(V, F, tolerance="1%", scheme="loop")  # edge_only: corners move
+    assert len(Fa) != len(F2) or not np.allclose(Va, V2)
+
+
 def test_cli_info_reports_adaptive(capsys):
     from hybridsub._app.cli import main
     src = os.path.join(DATA, "icosahedron.off")
