@@ -181,6 +181,27 @@ def test_region_refinement_with_options_is_exact(mesh, data):
         assert np.array_equal(r.corner_sharpness, left[r.corners])
 
 
+@cfg(5)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_tolerance_with_options_is_exact(mesh, data):
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    tags = {k: v for k, v in _options(data, V, F, tags, scheme).items() if k != "corner_sharpness"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="3%", max_levels=2, scheme=scheme, **tags)
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="3%", max_levels=2, scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces)
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    used = np.isin(np.arange(r.n_vertices), F2)
+    for j in range(int(r.vertex_level.max(initial=0)) + 1):
+        sel = np.flatnonzero((r.vertex_level == j) & used)
+        if len(sel):
+            L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max() <= 1e-9, (j, float(d.max()))
+
+
 def test_tolerance_with_boundary_and_holes():
     I, J = np.meshgrid(np.arange(7), np.arange(7), indexing="ij")
     V, F = ms.grid(6, 6, (I[:6, :6] + J[:6, :6]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
