@@ -59,8 +59,13 @@ def uniform_match(V, F, tags, scheme, r, X):
     index = np.full(len(X), -1, np.int64)
     apart = 10.0 * (diagonal(V) + 1.0)
     piece = _piece_of_vertices(F, r.faces, r.face_parent, len(X))
+    # Holes hide faces and leave the refinement as it is: the uniform vertices' pieces are
+    # those of the whole refinement, and a vertex only hidden faces use is not matched.
+    tags = {k: v for k, v in tags.items() if k != "holes"}
+    if tags.get("boundary") == "none":
+        tags["boundary"] = "edge_only"
     for j in range(top + 1):
-        sel = np.flatnonzero(r.vertex_level == j)
+        sel = np.flatnonzero((r.vertex_level == j) & (piece >= 0))
         if not len(sel):
             continue
         if j:
@@ -123,6 +128,162 @@ def test_region_refinement_is_crack_free_and_exact(mesh, data):
     # The faces asked for are refined `levels` times.
     assert (r.face_level[where[r.face_parent]] == levels).all()
     assert r.face_level.max(initial=0) <= levels
+
+
+def _options(data, V, F, tags, scheme):
+    """corner_sharpness (finite or infinite per corner), boundary and holes, drawn."""
+    tags = dict(tags)
+    if tags.get("corners") is not None and len(tags["corners"]) and scheme != "sqrt3":
+        cs = data.draw(st.lists(st.sampled_from([0.5, 1.0, 1.5, 2.5, np.inf]), min_size=len(tags["corners"]),
+                                max_size=len(tags["corners"])))
+        tags["corner_sharpness"] = np.array(cs)
+    tags["boundary"] = data.draw(st.sampled_from(["edge_only", "edge_and_corner", "none"]))
+    if data.draw(st.booleans()):
+        tags["holes"] = np.flatnonzero(np.random.default_rng(len(F)).random(len(F)) < 0.1)
+    return tags
+
+
+@cfg(30)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_region_refinement_with_options_is_exact(mesh, data):
+    # corner_sharpness, boundary and holes as refine takes them: every vertex is the uniform
+    # refinement's (with the same options) at its level; the holes' descendants left out.
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
+    if scheme == "sqrt3":
+        if len(ms.boundary_edges(F)):
+            scheme = "hybrid"
+        else:
+            tags = {}
+    tags = _options(data, V, F, tags, scheme)
+    levels = data.draw(st.integers(1, 3 if len(F) <= 40 else 2))
+    where = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1))).random(len(F)) < 0.3
+    r = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme=scheme, n_vertices=len(V), **tags)
+    uniform_match(V, F, tags, scheme, r, r.apply(V))
+    # Holes (and boundary="none"'s) leave the refinement as it is and hide faces, as refine does.
+    shown = {k: v for k, v in tags.items() if k != "holes"}
+    if shown["boundary"] == "none":
+        shown["boundary"] = "edge_only"
+    full = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme=scheme, n_vertices=len(V), **shown)
+    assert np.array_equal(r.apply(V), full.apply(V))
+    hidden = np.ones(len(F), bool)
+    hidden[hybridsub.refine(F, levels=1, scheme=scheme, n_vertices=len(V), **tags).face_parent] = False
+    assert np.array_equal(r.faces, full.faces[~hidden[full.face_parent]])
+    assert (r.face_level[where[r.face_parent]] == levels).all()
+    # The corners (with boundary="edge_and_corner" also its own) and the sharpness left to
+    # each at its level, as refine gives them at that level.
+    u0 = hybridsub.refine(F, levels=0, scheme=scheme, n_vertices=len(V), **tags)
+    cs = np.zeros(len(V))
+    cs[u0.corners] = np.inf if u0.corner_sharpness is None else u0.corner_sharpness
+    left = np.where(np.isinf(cs), cs, np.maximum(cs - r.vertex_level[:len(V)], 0))
+    assert np.array_equal(np.sort(r.corners), np.flatnonzero(left > 0))
+    if r.corner_sharpness is not None:
+        assert np.array_equal(r.corner_sharpness, left[r.corners])
+
+
+@cfg(5)
+@given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
+def test_tolerance_with_options_is_exact(mesh, data):
+    V, F, tags = mesh
+    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    tags = _options(data, V, F, tags, scheme)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="3%", max_levels=2, scheme=scheme, **tags)
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="3%", max_levels=2, scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces)
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    used = np.isin(np.arange(r.n_vertices), F2)
+    for j in range(int(r.vertex_level.max(initial=0)) + 1):
+        sel = np.flatnonzero((r.vertex_level == j) & used)
+        if len(sel):
+            L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max() <= 1e-9, (j, float(d.max()))
+
+
+def test_tolerance_with_boundary_and_holes():
+    I, J = np.meshgrid(np.arange(7), np.arange(7), indexing="ij")
+    V, F = ms.grid(6, 6, (I[:6, :6] + J[:6, :6]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
+    holes = [3, 17]
+    for boundary in ("edge_only", "edge_and_corner", "none"):
+        tags = dict(boundary=boundary, holes=holes)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = hybridsub.refine_adaptive(F, V=V, tolerance="0.5%", scheme="loop", **tags)
+            V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.5%", scheme="loop", **tags)
+        assert np.array_equal(F2, r.faces)
+        index = uniform_match(V, F, tags, "loop", r, r.apply(V))
+        used = np.isin(np.arange(r.n_vertices), F2)
+        for j in range(int(r.vertex_level.max()) + 1):
+            sel = np.flatnonzero((r.vertex_level == j) & used)
+            L = hybridsub.limit_positions(V, F, levels=j, scheme="loop", **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max(initial=0) <= 1e-9, (boundary, j, d.max())
+        u = hybridsub.refine(F, levels=1, scheme="loop", **tags)
+        assert np.array_equal(np.unique(r.face_parent), np.unique(u.face_parent))  # holes left out
+
+
+def _book(n=4):
+    """Three bumpy sheets sharing a row of edges (each of them in three faces)."""
+    I, J = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    G, Fg = ms.grid(n, n, (I[:n, :n] + J[:n, :n]) % 2 == 0)
+    x, y = G[:, 0], G[:, 1]
+    sheets = [np.column_stack([x, y, 0.2 * np.sin(x) * y]), np.column_stack([x, 0 * y, y + 0.1 * x * y]),
+              np.column_stack([x, 0 * y, -y])]
+    V = np.vstack(sheets)
+    F = np.vstack([Fg, Fg + len(G), Fg[:, ::-1] + 2 * len(G)])
+    _, first, inv = np.unique(np.round(V, 9), axis=0, return_index=True, return_inverse=True)
+    return V[first], inv.ravel()[F]
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_non_manifold_cut_is_exact(scheme):
+    # non_manifold="cut" as refine takes it: the region's vertices are the uniform refinement's
+    # of the cut copy; to a tolerance, at the cut copy's limit positions.
+    V, F = _book()
+    tags = dict(non_manifold="cut", sharp_edges=F[:2, :2])
+    with pytest.raises(hybridsub.MeshError):
+        hybridsub.refine_adaptive(F, where=[0], levels=1, scheme=scheme)
+    r = hybridsub.refine_adaptive(F, where=np.arange(12), levels=2, scheme=scheme, **tags)
+    uniform_match(V, F, tags, scheme, r, r.apply(V))
+    assert r.face_level.max() == 2 and r.face_level.min() == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    from hybridsub._input import open_gate
+    cut = open_gate(F, tags["sharp_edges"], 0, scheme=scheme, non_manifold="cut")  # the cut copy
+    for j in range(int(r.vertex_level.max()) + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        L = hybridsub.limit_positions(V[cut.cut.origin], cut.faces, cut.sharp_edges, levels=j, scheme=scheme,
+                                      corners=np.flatnonzero(cut.corner))
+        d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+        assert d.max(initial=0) <= 1e-9, (j, d.max())
+
+
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_tolerance_with_semi_sharp_corners(scheme):
+    # A corner of sharpness 1.5 is pinned for two levels, then moves: its limit is not the
+    # infinitely sharp corner's, and every output vertex is at its uniform vertex's limit.
+    V, F = ms.icosahedron()
+    tags = dict(corners=[0, 5], corner_sharpness=[1.5, np.inf])
+    r = hybridsub.refine_adaptive(F, V=V, tolerance="1%", scheme=scheme, **tags)
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="1%", scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    for j in range(int(r.vertex_level.max()) + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+        d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+        assert d.max(initial=0) <= 1e-9, (j, d.max())
+    assert np.allclose(V2[5], V[5]) and not np.allclose(V2[0], V[0])
+    Vb, Fb = _book()  # cut copies of a semi-sharp corner: refused by name with a tolerance
+    with pytest.raises(ValueError, match="infinitely sharp corners only"):
+        hybridsub.subdivide_adaptive(Vb, Fb, tolerance="1%", scheme=scheme, non_manifold="cut", corners=[0],
+                                     corner_sharpness=[1.5])
 
 
 @pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
@@ -317,6 +478,21 @@ def test_cli_subdivide_to_a_tolerance(tmp_path, capsys):
         with pytest.raises(SystemExit) as e:
             main(["subdivide", src, "-o", str(out), "--tolerance", bad])
         assert e.value.code == 2
+
+
+def test_cli_tolerance_takes_boundary(tmp_path, capsys):
+    from hybridsub._app.cli import main
+    I, J = np.meshgrid(np.arange(6), np.arange(6), indexing="ij")
+    V, F = ms.grid(5, 5, (I[:5, :5] + J[:5, :5]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
+    src, out = tmp_path / "g.obj", tmp_path / "a.obj"
+    hybridsub.write_mesh(str(src), V, F)
+    assert main(["subdivide", str(src), "-o", str(out), "--tolerance", "1%", "--boundary", "edge_and_corner",
+                 "--scheme", "loop"]) == 0
+    m = hybridsub.read_mesh(str(out))
+    V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="1%", boundary="edge_and_corner", scheme="loop")
+    assert np.array_equal(m.faces, F2) and np.allclose(m.vertices, V2, atol=1e-9)
+    Va, Fa = hybridsub.subdivide_adaptive(V, F, tolerance="1%", scheme="loop")  # edge_only: corners move
+    assert len(Fa) != len(F2) or not np.allclose(Va, V2)
 
 
 def test_cli_info_reports_adaptive(capsys):

@@ -441,15 +441,14 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
 
     if mesh.uv is not None:
         say(opts, "note: texture coordinates dropped: adaptive refinement does not refine face-varying data yet")
-    if feat.corner_sharpness is not None or opts.boundary != "edge_only":
-        raise PipelineError(f"{path}: adaptive refinement (--tolerance) takes neither semi-sharp corners nor "
-                            "--boundary yet; refine uniformly (--levels)")
     t = time.perf_counter()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", AdaptiveWarning)
             res = adaptive_result(mesh.vertices, mesh.faces, tolerance=opts.tolerance, max_levels=opts.max_levels,
-                                  scheme=opts.scheme, loop_weights=opts.loop_weights, **feat.tags())
+                                  scheme=opts.scheme, loop_weights=opts.loop_weights, boundary=opts.boundary,
+                                  holes=mesh.holes if len(mesh.holes) else None,
+                                  non_manifold=opts.non_manifold, **feat.tags())
     except MeshError as e:
         raise PipelineError(f"{path}: {e}") from None
     except ValueError as e:

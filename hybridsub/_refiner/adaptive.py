@@ -39,7 +39,7 @@ import scipy.sparse as sp
 
 from .._input import RefineInput
 from .._topology import Level, build_level, child_level, plan_step
-from .refinement import Refinement, RefinementStep
+from .refinement import Refinement, RefinementStep, _compose_cut
 from .stencils import step_matrix
 
 
@@ -56,7 +56,9 @@ class AdaptiveMesh:
     genuine: np.ndarray  # (m,) bool: a face of the uniform refinement of its level
     face_parent: np.ndarray  # (m,) int64 input face
     vertex_level: np.ndarray  # (n,) int64
-    corner: np.ndarray  # (n,) bool
+    # (n,) bool corners, or with semi-sharp corners (``corner_sharpness=``) float64: each input
+    # vertex's sharpness at level 0 (inf a corner, 0 none), spent one a level (:func:`corners_at`)
+    corner: np.ndarray
 
     def active(self, k: int) -> np.ndarray:
         """(m,) faces that a step from level k may refine."""
@@ -82,8 +84,28 @@ def start(inp: RefineInput) -> AdaptiveMesh:
     """The adaptive mesh of level 0: the checked input, every face active."""
     level = inp.level
     m, n = inp.n_faces, inp.n_vertices
+    corner = inp.corner if inp.corner_sharpness is None else inp.corner_sharpness
     return AdaptiveMesh(inp.faces, n, level.twin, level.hsharp, inp.face_sharp.copy(), np.zeros(m, np.int64),
-                        np.ones(m, bool), np.arange(m, dtype=np.int64), np.zeros(n, np.int64), inp.corner.copy())
+                        np.ones(m, bool), np.arange(m, dtype=np.int64), np.zeros(n, np.int64), corner.copy())
+
+
+def corners_at(corner: np.ndarray, levels) -> np.ndarray:
+    """The corner argument of a step from level ``levels`` (a scalar, or one per vertex): the
+    mask as it is, or each vertex's sharpness less what ``levels`` steps spent (inf stays), as
+    the uniform steps decay it (``next_corners``)."""
+    if corner.dtype != np.float64:
+        return corner
+    return np.where(np.isinf(corner), corner, np.maximum(corner - levels, 0.0))
+
+
+def corners_left(mesh: AdaptiveMesh) -> tuple[np.ndarray, np.ndarray | None]:
+    """The vertices still corners at their own level and, with semi-sharp ones, the sharpness
+    left to each (as ``Refinement.corners`` and ``corner_sharpness``)."""
+    if mesh.corner.dtype != np.float64:
+        return np.flatnonzero(mesh.corner), None
+    left = corners_at(mesh.corner, mesh.vertex_level)
+    c = np.flatnonzero(left > 0)
+    return c, left[c]
 
 
 def _region_level(mesh: AdaptiveMesh, region: np.ndarray):
@@ -141,7 +163,7 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     F, n = mesh.faces, mesh.n_vertices
     rf, sub_ids, local, level, border = _region_level(mesh, region)
     ns, Fs = len(sub_ids), level.faces
-    plan = plan_step(level, mesh.corner[sub_ids], scheme, k + 1, loop_weights)
+    plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), scheme, k + 1, loop_weights)
     faces_c, child, offsets = child_level(level, plan)
     S = step_matrix(level, plan).tocsr()
     n_sub_new = plan.n_new
@@ -196,7 +218,7 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
         hsharp = merged(old_h, new_h).ravel()
     vertex_level = np.concatenate([mesh.vertex_level, np.full(n1 - n, k + 1, np.int64)])
     vertex_level[prom] = k + 1
-    corner = np.concatenate([mesh.corner, np.zeros(n1 - n, bool)])
+    corner = np.concatenate([mesh.corner, np.zeros(n1 - n, mesh.corner.dtype)])
     faces1 = np.ascontiguousarray(faces1, dtype=np.int64)
     twin1 = build_level(faces1, n1).twin
     out = AdaptiveMesh(faces1, n1, twin1, hsharp, face_sharp, face_level, genuine, face_parent, vertex_level, corner)
@@ -272,7 +294,6 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
     want = np.minimum(np.asarray(want0, np.int64), max_levels)
     steps, st = [], None
     missed, missed_level = [], []
-    corners_out = np.flatnonzero(inp.corner)
     for k in range(max_levels + 1):
         act = mesh.active(k)
         if on_level is not None:
@@ -291,12 +312,15 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
         want = want[st.face_parent]
         pairs, sharp = edge_tags(mesh)
         steps.append(RefinementStep(st.faces, st.matrix, pairs, sharp, inp.faces_out(mesh.face_sharp),
-                                    np.flatnonzero(mesh.corner), st.face_parent))
+                                    corners_left(mesh)[0], st.face_parent))
     pairs, sharp = edge_tags(mesh)
     face_parent = mesh.face_parent.copy()
+    corners_out, corner_sharpness = corners_left(mesh)
     r = Refinement(mesh.faces, pairs, sharp, inp.faces_out(mesh.face_sharp), corners_out, face_parent, steps,
-                   inp.n_vertices, inp.max_memory, None, coarse_faces=inp.faces, face_level=mesh.face_level.copy(),
-                   vertex_level=mesh.vertex_level.copy())
+                   inp.n_vertices, inp.max_memory, None, coarse_faces=inp.faces if inp.cut is None else None,
+                   face_level=mesh.face_level.copy(), vertex_level=mesh.vertex_level.copy(),
+                   corner_sharpness=corner_sharpness)
+    r = _compose_cut(inp, r)  # non_manifold="cut": the first step takes the caller's vertices
     cat = (lambda a: np.concatenate(a) if a else np.empty(0, np.int64))
     return AdaptiveRun(r, cat(missed), cat(missed_level), mesh)
 

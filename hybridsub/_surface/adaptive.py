@@ -15,11 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
-from .._refiner import FaceCharts, Refinement, refine
+from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.chart import best_held_corners
-from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement, refine_region
+from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
-from .._typing import ArrayLike, LoopWeights, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, NonManifold, Scheme
 from .mask_plan import plan_level
 from .surface import LimitSurface
 from .vertex_limit import limit_positions
@@ -90,6 +90,14 @@ def _closed_for_sqrt3(inp: RefineInput) -> None:
                          'whose boundary is a crease')
 
 
+def spread_one_ring(mesh: AdaptiveMesh, want: np.ndarray) -> np.ndarray:
+    """Each face's wanted level raised to the largest wanted level of the faces that share a
+    vertex with it."""
+    at_v = np.zeros(mesh.n_vertices, np.int64)
+    np.maximum.at(at_v, mesh.faces.ravel(), np.repeat(want, 3))
+    return np.maximum(want, at_v[mesh.faces].max(axis=1))
+
+
 class Criterion:
     """The error criterion, called by the driver at every level (see ``OnLevel``).
 
@@ -106,7 +114,6 @@ class Criterion:
         self.P = X.copy()  # level positions
         self.Q = X.copy()  # output positions: limit positions where known
         self.known = np.zeros(len(X), bool)
-        self.prev = None  # the previous level: (mesh, active, k, positions)
         self.error = np.zeros(inp.n_faces)
         self.done = np.zeros(inp.n_faces, bool)
 
@@ -130,16 +137,24 @@ class Criterion:
             self.error = self.error[step.face_parent]
             self.done = self.done[step.face_parent] & (mesh.face_level < k)
         fresh = np.flatnonzero(~self.done)
+        if self.inp.hole is not None:  # faces not rendered: not measured (error 0)
+            hidden = self.inp.hole[mesh.face_parent[fresh]]
+            self.error[fresh[hidden]] = 0.0
+            self.done[fresh[hidden]] = True
+            fresh = fresh[~hidden]
         self._mask_pass(mesh, active)
-        self.error[fresh] = self._errors(mesh, fresh, step)
+        self.error[fresh] = self._errors(mesh, fresh)
         self.done[fresh] = True
         want = np.zeros(len(mesh.faces), np.int64)
         over = self.error > self.tol
         rate = np.where(mesh.face_sharp, RATE[True], RATE[False])
         more = np.ceil(np.log(self.error[over] / self.tol) / np.log(rate[over])).astype(np.int64)
         want[over] = mesh.face_level[over] + np.maximum(more, 1)
-        self.prev = (mesh, active, k, self.P)
-        return want
+        # The faces round a face over the tolerance are wanted at its level too, so that the
+        # closure faces at the region's border are made in faces that are within the tolerance
+        # already: a closure face is never refined again, and one over the tolerance would make
+        # the driver start again with a wider margin (adaptive_refinement).
+        return spread_one_ring(mesh, want)
 
     def _masked_limits(self, mesh: AdaptiveMesh, active: np.ndarray, P: np.ndarray, todo: np.ndarray):
         """Limit positions by the stationary limit masks (those of ``limit_positions``) of the
@@ -154,6 +169,10 @@ class Criterion:
         all_count = np.bincount(F.ravel(), minlength=n)
         act_count = np.bincount(F[af].ravel(), minlength=n)
         todo = (act_count == all_count) & (act_count > 0) & todo
+        corner = mesh.corner
+        if corner.dtype == np.float64:  # semi-sharp corners: no stationary mask, the surface places them
+            todo &= ~(np.isfinite(corner) & (corner > 0))
+            corner = corner > 0
         if not todo.any():
             return none
         ids = np.unique(F[af].ravel())
@@ -174,7 +193,7 @@ class Criterion:
         owner = level.edge_owner
         hs = mesh.hsharp[h] if mesh.hsharp is not None and self.inp.scheme != "sqrt3" else np.zeros(len(h))
         esharp = np.where(level.twin[owner] < 0, np.inf, hs[owner])
-        plan = plan_level(level, esharp, mesh.face_sharp[af], mesh.corner[ids], self.inp.scheme,
+        plan = plan_level(level, esharp, mesh.face_sharp[af], corner[ids], self.inp.scheme,
                           self.inp.loop_weights)
         v = np.flatnonzero(todo)
         v = v[plan.pos_ok[local[v]]]
@@ -188,48 +207,12 @@ class Criterion:
         self.Q[v] = q
         self.known[v] = True
 
-    def _virtual_pass(self, step: RegionStep, need: np.ndarray) -> np.ndarray:
-        """Limit positions of ``need`` (vertices of this level whose ring here is not complete)
-        from the uniform step of every active face of the previous level, made aside: there
-        their rings are complete more often. Returns the vertices still without one."""
-        if self.prev is None or not len(need):
-            return need
-        pm, pa, pk, PP = self.prev
-        if not pa.any():
-            return need
-        vm, vst = refine_region(pm, pa, pk, "hybrid" if self.inp.scheme == "sqrt3" else self.inp.scheme,
-                                self.inp.loop_weights)
-        n0 = pm.n_vertices
-        todo = np.zeros(vm.n_vertices, bool)
-        # Each vertex of this level in the aside step: old ones by index, new ones by what made them.
-        where = np.full(len(need), -1, np.int64)
-        old = need < n0
-        where[old] = need[old]
-        order = np.argsort(vst.source)
-        keys = vst.source[order]
-        k = step.source[need[~old] - n0]
-        at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
-        hit = keys[at] == k
-        idx = np.flatnonzero(~old)
-        where[idx[hit]] = n0 + order[at[hit]]
-        found = where >= 0
-        todo[where[found]] = True
-        v, q = self._masked_limits(vm, vm.active(pk + 1), vst.matrix @ PP, todo)
-        got = np.full(vm.n_vertices, -1, np.int64)
-        got[v] = np.arange(len(v))
-        ok = found & (got[np.maximum(where, 0)] >= 0)
-        self.Q[need[ok]] = q[got[where[ok]]]
-        self.known[need[ok]] = True
-        return need[~ok]
-
-    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray, step: RegionStep | None) -> np.ndarray:
+    def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray) -> np.ndarray:
         """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
         once) and its centroid against the surface."""
         F = mesh.faces
         need = np.unique(F[fresh].ravel())
         need = need[~self.known[need]]
-        if step is not None:
-            need = self._virtual_pass(step, need)
         if len(need):
             self._limits(mesh, fresh, need)
         out = self.Q if self.limit else self.P
@@ -284,9 +267,20 @@ class AdaptiveResult:
 
 def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, limit: bool) -> AdaptiveResult:
     tol = tolerance_of(tolerance, X)
-    surface = LimitSurface(X, inp.faces, inp.sharp_edges, scheme=inp.scheme, sharpness=inp.sharpness,
-                           sharp_faces=inp.face_sharp if inp.scheme == "hybrid" else None,
-                           corners=np.flatnonzero(inp.corner), loop_weights=inp.loop_weights)
+    sharp_faces = inp.face_sharp if inp.scheme == "hybrid" else None
+    if inp.cut is None:
+        surface = LimitSurface(X, inp.faces, inp.sharp_edges, scheme=inp.scheme, sharpness=inp.sharpness,
+                               sharp_faces=sharp_faces, loop_weights=inp.loop_weights, **_corner_tags(inp))
+    else:  # the caller's mesh, cut as the gate cut it; the criterion follows the cut copy's vertices
+        vs = inp.corner_sharpness
+        if vs is not None and (np.isfinite(vs) & (vs > 0)).any():
+            raise ValueError('a tolerance with non_manifold="cut" takes infinitely sharp corners only (finite '
+                             "corner_sharpness): refine a region (where=, levels=) or give the corners infinite sharpness")
+        u = inp.uncut
+        surface = LimitSurface(X, u.faces, u.sharp_edges, scheme=inp.scheme, sharpness=u.sharpness,
+                               sharp_faces=sharp_faces, corners=np.flatnonzero(u.corner),
+                               loop_weights=inp.loop_weights, non_manifold="cut")
+        X = X[inp.cut.origin]
     holder = {}
 
     def on_level(k, mesh, active, step):
@@ -296,26 +290,30 @@ def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, l
 
     run = adaptive_refinement(inp, np.zeros(inp.n_faces, np.int64), max_levels, on_level)
     c = holder.get("c")
+    refinement = without_holes(run.refinement, inp.hole)
     if c is None:  # no faces
-        return AdaptiveResult(run.refinement, X.copy(), 0.0, tol)
+        return AdaptiveResult(refinement, X.copy(), 0.0, tol)
     P = c.positions(run.mesh)
     err = float(c.error.max(initial=0.0))
     if err > tol:
         warnings.warn(f"tolerance {tol:.6g} not reached in max_levels={max_levels} levels: the largest error is "
                       f"{err:.6g} ({err / tol:.3g}× the tolerance); raise max_levels to go further",
                       AdaptiveWarning, stacklevel=4)
-    return AdaptiveResult(run.refinement, P, err, tol)
+    return AdaptiveResult(refinement, P, err, tol)
 
 
 def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *, tolerance,
                     max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop") -> AdaptiveResult:
+                    corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                    corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                    holes: ArrayLike | None = None, non_manifold: NonManifold = "raise") -> AdaptiveResult:
     """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
     command line)."""
     X = as_vertices(V)
     ml = _max_levels(max_levels)
-    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights)
+    inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights,
+                corner_sharpness, boundary, holes, non_manifold)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
 
@@ -340,11 +338,22 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
     return float(np.linalg.norm(S - T, axis=2).max(initial=0.0))
 
 
-def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights) -> RefineInput:
+def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+          corner_sharpness=None, boundary="edge_only", holes=None, non_manifold="raise") -> RefineInput:
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
-                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+                    sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold)
     _closed_for_sqrt3(inp)
     return inp
+
+
+def _corner_tags(inp: RefineInput) -> dict:
+    """The gate's corners as ``LimitSurface`` takes them: indices, and their sharpness beside
+    them where some are semi-sharp."""
+    if inp.corner_sharpness is None:
+        return dict(corners=np.flatnonzero(inp.corner))
+    c = np.flatnonzero(inp.corner_sharpness > 0)
+    return dict(corners=c, corner_sharpness=inp.corner_sharpness[c])
 
 
 def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where: ArrayLike | None = None,
@@ -352,7 +361,9 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
                     max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
-                    n_vertices: int | None = None) -> Refinement:
+                    n_vertices: int | None = None, corner_sharpness: ArrayLike | None = None,
+                    boundary: Boundary = "edge_only", holes: ArrayLike | None = None,
+                    non_manifold: NonManifold = "raise") -> Refinement:
     """Refine only where it matters: a region to a level, or everywhere to a tolerance.
 
     Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
@@ -369,6 +380,11 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
     ----------
     F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, n_vertices
         As for :func:`hybridsub.refine` (checked the same way). ``"sqrt3"`` needs a closed mesh.
+    corner_sharpness, boundary, holes, non_manifold
+        As for :func:`hybridsub.refine`: semi-sharp corners (with a tolerance, not together
+        with ``"cut"``), OpenSubdiv's boundary interpolation, faces left
+        out of ``faces`` (those descending from a hole; a hole is not measured by ``tolerance``)
+        and ``"cut"``: a non-manifold input refined as its manifold cut copy.
     where : (m,) bool mask or array_like of int
         The input faces to refine ``levels`` times.
     levels : int
@@ -408,20 +424,24 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         X = as_vertices(V)
         ml = _max_levels(max_levels)
         inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
-                    sharp_faces, corners, loop_weights)
+                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold)
         return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
     if levels is None:
         raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
-    inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights)
+    inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
+                corner_sharpness, boundary, holes, non_manifold)
     mask = _where_mask(where, inp.n_faces)
-    return adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels).refinement
+    run = adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels)
+    return without_holes(run.refinement, inp.hole)
 
 
 def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None, *,
                        tolerance: float | str, max_levels: int = 8, limit: bool = True, scheme: Scheme = "hybrid",
                        sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
-                       corners: ArrayLike | None = None,
-                       loop_weights: LoopWeights = "loop") -> tuple[np.ndarray, np.ndarray]:
+                       corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
+                       corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
+                       holes: ArrayLike | None = None,
+                       non_manifold: NonManifold = "raise") -> tuple[np.ndarray, np.ndarray]:
     """Subdivide until the mesh is within ``tolerance`` of the limit surface, only where needed.
 
     Each face is refined until the largest distance between it and the limit surface over it,
@@ -434,8 +454,11 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     Parameters
     ----------
     V : (n, 3) array_like of float
-    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights
-        As for :func:`hybridsub.subdivide`.
+    F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, boundary, holes, non_manifold
+        As for :func:`hybridsub.subdivide` (holes: left out of ``F2`` and not measured; with
+        ``"cut"`` the output is the refined cut copy, its cut vertices apart).
+    corner_sharpness
+        As for :func:`hybridsub.subdivide` (finite values not together with ``"cut"``).
     tolerance : float or str
         In mesh units, or a string such as ``"0.1%"`` of the bounding-box diagonal.
     max_levels : int
@@ -459,5 +482,7 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     (3, 3)
     """
     res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
-                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights)
+                          sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
+                          corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
+                          non_manifold=non_manifold)
     return res.positions.copy(), res.refinement.faces.copy()
