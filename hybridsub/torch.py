@@ -277,10 +277,14 @@ class _Sequence:
         return X
 
 
+#: Face arguments that may be a boolean mask instead of indices.
+_MASKS = ("sharp_faces", "holes")
+
+
 def _indices(x, name: str):
     """An integer tensor as NumPy (the rest as it is: the gate checks it)."""
     if isinstance(x, torch.Tensor):
-        if x.dtype.is_floating_point or x.dtype.is_complex or (x.dtype == torch.bool and name != "sharp_faces"):
+        if x.dtype.is_floating_point or x.dtype.is_complex or (x.dtype == torch.bool and name not in _MASKS):
             raise TypeError(f"{name} must hold integer indices, got a tensor of {x.dtype}")
         return x.detach().cpu().numpy()
     return x
@@ -317,8 +321,8 @@ class _SharpChain(torch.autograd.Function):
 
 
 def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor | None = None, levels: int = 1,
-              scheme: str = "hybrid", sharp_faces=None, corners=None,
-              loop_weights: str = "loop") -> tuple[torch.Tensor, torch.Tensor]:
+              scheme: str = "hybrid", sharp_faces=None, corners=None, loop_weights: str = "loop",
+              corner_sharpness=None, boundary: str = "edge_only", holes=None) -> tuple[torch.Tensor, torch.Tensor]:
     """:func:`hybridsub.subdivide`, differentiable in the positions and in the creases' sharpness.
 
     The topology and the tags are refined from ``F``, ``sharp_edges`` and the current
@@ -342,8 +346,9 @@ def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor |
         Creases as vertex pairs.
     sharpness : torch.Tensor, (k,), optional
         Their sharpness (default: infinite); may require grad.
-    levels, scheme, sharp_faces, corners, loop_weights
-        As in :func:`hybridsub.subdivide`.
+    levels, scheme, sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes
+        As in :func:`hybridsub.subdivide` (the faces of holes are left out of ``F2``). With
+        semi-sharp corners (finite ``corner_sharpness``) ``sharpness`` may not require grad.
 
     Returns
     -------
@@ -374,14 +379,17 @@ def subdivide(V: torch.Tensor, F, sharp_edges=None, *, sharpness: torch.Tensor |
     F = _indices(F, "F")
     sharp_edges = _indices(sharp_edges, "sharp_edges")
     s_np = None if sharpness is None else sharpness.detach().cpu().double().numpy()
+    cs = corner_sharpness.detach().cpu().numpy() if isinstance(corner_sharpness, torch.Tensor) else corner_sharpness
     inp = open_gate(F, sharp_edges, levels, n_vertices=n, scheme=scheme, sharpness=s_np,
                     sharp_faces=_indices(sharp_faces, "sharp_faces"), corners=_indices(corners, "corners"),
-                    loop_weights=loop_weights)
+                    loop_weights=loop_weights, corner_sharpness=cs, boundary=boundary,
+                    holes=_indices(holes, "holes"))
     want_s = sharpness is not None and sharpness.requires_grad and torch.is_grad_enabled()
     pairs, s_norm = as_sharp_edges(sharp_edges, s_np, n)
     steps = sharpness_steps(inp, pairs, s_norm, slopes=want_s)
     dtype, device = V.dtype, V.device
-    F2 = torch.as_tensor(steps.faces, dtype=torch.int64, device=device)
+    kept = steps.faces if steps.hole is None else steps.faces[~steps.hole]
+    F2 = torch.as_tensor(kept, dtype=torch.int64, device=device)
     if not steps.matrices:  # levels=0
         return V.clone(), F2
     if _use_kernels(device):

@@ -149,6 +149,30 @@ def test_subdivide_equals_numpy(fandisk, scheme, path):
         assert F2t.dtype == torch.int64 and np.array_equal(F2t.numpy(), F2)
 
 
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_subdivide_takes_opensubdivs_options(fandisk, scheme, path):
+    # corner_sharpness, boundary and holes as hybridsub.subdivide takes them; with a sharpness
+    # gradient wanted, a semi-sharp corner is refused by name.
+    V, F, feat = fandisk
+    s = np.random.default_rng(4).uniform(0.2, 3, len(feat.sharp_edges))
+    holes = np.zeros(len(F), bool)
+    holes[::50] = True
+    kw = dict(corners=feat.corners, corner_sharpness=np.linspace(0.5, 3.5, len(feat.corners)),
+              boundary="edge_and_corner", levels=2, scheme=scheme)
+    want, F2 = hybridsub.subdivide(V, F, feat.sharp_edges, sharpness=s, holes=holes, **kw)
+    got, F2t = ht.subdivide(torch.tensor(V), F, feat.sharp_edges, sharpness=torch.tensor(s), holes=torch.tensor(holes),
+                            **kw)
+    assert np.abs(got.numpy() - want).max() <= 1e-12 * np.abs(want).max()
+    assert np.array_equal(F2t.numpy(), F2) and len(F2) < 16 * len(F)
+    with pytest.raises(ValueError, match="semi-sharp corners"):
+        ht.subdivide(torch.tensor(V), F, feat.sharp_edges, sharpness=torch.tensor(s, requires_grad=True), **kw)
+    st = torch.tensor(s, requires_grad=True)  # infinitely sharp corners: the gradient as before
+    V2, _ = ht.subdivide(torch.tensor(V), F, feat.sharp_edges, sharpness=st, levels=2, scheme=scheme,
+                         corners=feat.corners, holes=np.flatnonzero(holes))
+    V2.sum().backward()
+    assert st.grad.shape == (len(s),)
+
+
 def numeric_gradient(V, F, E, s, G, scheme, levels, h=1e-3):
     """d <G, subdivide(V, F, E, sharpness=s)> / d s by central differences, from below at
     integers (the documented one-sided derivative). The result is affine in each sharpness

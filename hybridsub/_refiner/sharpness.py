@@ -30,7 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._input import RefineInput
-from .._topology import LABEL_BASE, Level, StepPlan, blend_slopes, child_labels
+from .._topology import LABEL_BASE, Level, StepPlan, blend_slopes, child_labels, face_parents
 from .budget import Budget
 from .loop import walk
 from .stencils import step_matrix
@@ -57,6 +57,7 @@ class SharpnessSteps:
     matrices: list  # scipy.sparse.csr_matrix per step
     faces: np.ndarray
     slopes: list  # Slopes per step
+    hole: np.ndarray | None = None  # (m,) the finest faces descending from a hole (None: no holes)
 
 
 def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray,
@@ -71,13 +72,19 @@ def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray,
     """
     if inp.cut is not None or inp.uv is not None:
         raise ValueError("sharpness derivatives are not available with non_manifold='cut' or uv_faces")
+    if slopes and inp.corner_sharpness is not None and (np.isfinite(inp.corner_sharpness) & (inp.corner_sharpness > 0)).any():
+        raise ValueError("sharpness derivatives are not available with semi-sharp corners (finite corner_sharpness): "
+                         "give the corners infinite sharpness, or take no derivative in the creases' sharpness")
     labels = _first_labels(inp.level, pairs, sharpness)
     want = slopes
     matrices, slopes = [], []
     faces = inp.faces.copy()
+    hole = inp.hole
     n0 = inp.n_vertices
     for s in walk(inp, Budget(inp.levels, inp.scheme, inp.max_memory)):  # refused before step 1 if too large
         matrices.append(step_matrix(s.level, s.plan))
+        if hole is not None:
+            hole = hole[face_parents(s.offsets)]
         if not want:
             faces = s.faces
             continue
@@ -87,7 +94,7 @@ def sharpness_steps(inp: RefineInput, pairs: np.ndarray, sharpness: np.ndarray,
         if s.step < inp.levels:
             labels = child_labels(s.level, s.plan, labels)
         faces = s.faces
-    return SharpnessSteps(matrices, faces, slopes)
+    return SharpnessSteps(matrices, faces, slopes, hole)
 
 
 def _first_labels(level: Level, pairs: np.ndarray, sharpness: np.ndarray) -> np.ndarray:
