@@ -1,6 +1,6 @@
 """Numba kernels of the vertex lane (:mod:`.vertex_lane`): every vertex's face corners grouped,
-and the limit position and normal of every smooth vertex of a pure region in one pass over
-its ring.
+and the limit position and normal of every smooth vertex of a pure region, and of every
+crease and boundary vertex among Loop faces, in one pass over its ring.
 
 Private. Contiguous arrays in.
 """
@@ -45,25 +45,118 @@ def corner_slots(F, n, A, B, face):
     return start
 
 
-def _smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, cos_table, sin_table, want_normals):
-    """Limit position and unit normal of every vertex whose ring is one closed fan of faces of
-    one kind (all √3 or all Loop), with no tag (``blocked`` False).
+@kernel(inline="always")
+def _walk(start, A, B, v, ring, off, t0, closed):
+    """Follow ``v``'s faces ``(v, p_j, p_{j+1})`` from slot ``t0`` into ``ring[off:]``; returns
+    the entries written (``k`` for a closed fan, ``k + 1`` for an open one), 0 where the walk
+    is not one fan of all ``k`` faces, −1 where a closed walk met an opening."""
+    lo = start[v]
+    k = start[v + 1] - lo
+    ring[off] = A[t0]
+    cur = B[t0]
+    for j in range(1, k):
+        if cur == ring[off]:  # back at the start early: a second fan
+            return 0
+        found = -1
+        for t in range(lo, lo + k):
+            if A[t] == cur:
+                found = t
+                break
+        if found < 0:
+            return -1 if closed else 0
+        ring[off + j] = cur
+        cur = B[found]
+    if closed:
+        return k if cur == ring[off] else 0
+    ring[off + k] = cur
+    return k + 1
+
+
+@kernel(inline="always")
+def _fan(start, A, B, v, ring, off):
+    """``v``'s ring into ``ring[off:]``: ``(entries, closed)``; entries 0 where its faces are
+    not one fan (two fans, two openings). A closed ring starts at ``A[start[v]]`` (the first
+    face's), an open one at the face after the opening."""
+    lo = start[v]
+    k = start[v + 1] - lo
+    m = _walk(start, A, B, v, ring, off, lo, True)
+    if m >= 0:
+        return m, True
+    t0 = -1
+    for t in range(lo, lo + k):  # the opening: a face whose p_j ends no other face
+        a = A[t]
+        hit = False
+        for u in range(lo, lo + k):
+            if B[u] == a:
+                hit = True
+                break
+        if not hit:
+            if t0 >= 0:
+                return 0, False
+            t0 = t
+    if t0 < 0:
+        return 0, False
+    return _walk(start, A, B, v, ring, off, t0, False), False
+
+
+@kernel(inline="always")
+def _sector_normal(X, v, ring, off, first, m, wrap, across, sin_half):
+    """Unit normal of the crease sector ``q_j = ring[off + (first + j) % wrap]``, ``j = 0 … m``
+    (``m`` faces): ``(q_0 − q_m) × (a v + b (q_0 + q_m) + Σ sin(πj/m) q_j)``; the fourth
+    value False where the pair is degenerate (the general path's fan normal applies)."""
+    q0 = ring[off + first % wrap]
+    qm = ring[off + (first + m) % wrap]
+    ux, uy, uz = X[q0, 0] - X[qm, 0], X[q0, 1] - X[qm, 1], X[q0, 2] - X[qm, 2]
+    ca, cb = across[m, 0], across[m, 1]
+    wx = ca * X[v, 0] + cb * (X[q0, 0] + X[qm, 0])
+    wy = ca * X[v, 1] + cb * (X[q0, 1] + X[qm, 1])
+    wz = ca * X[v, 2] + cb * (X[q0, 2] + X[qm, 2])
+    for j in range(1, m):
+        q = ring[off + (first + j) % wrap]
+        c = sin_half[m, j]
+        wx += c * X[q, 0]
+        wy += c * X[q, 1]
+        wz += c * X[q, 2]
+    nx = uy * wz - uz * wy
+    ny = uz * wx - ux * wz
+    nz = ux * wy - uy * wx
+    size = np.sqrt(nx * nx + ny * ny + nz * nz)
+    scale = np.sqrt(ux * ux + uy * uy + uz * uz) * np.sqrt(wx * wx + wy * wy + wz * wz)
+    if not size > 1e-12 * scale:
+        return 0.0, 0.0, 0.0, False
+    return nx / size, ny / size, nz / size, True
+
+
+def _vertex_limits(start, A, B, face, X, blocked, crease_count, crease_nb, face_sharp, w_table, cos_table, sin_table,
+                   crease_mask, across, sin_half, want_normals, one_side):
+    """Limit position and unit normal of every vertex whose faces are one fan of one kind and
+    which is untagged (smooth), or, among Loop faces only, on one crease through it or on the
+    boundary (crease vertices); ``blocked`` (corners, ends of semi-sharp creases) are not.
 
     The corners of ``v`` are the slots of :func:`corner_slots`; the ring ``p_0 … p_{k−1}``
-    follows faces ``(v, p_j, p_{j+1})`` from ``p_0 = A[start[v]]``. Position
-    ``(1 − k w) v + w Σ p_j``, ``w = w_table[region, k]`` (region 1: Loop faces); normal
-    ``t1 × t2``, ``t1 = Σ cos_table[k, j] p_j``, ``t2 = Σ sin_table[k, j] p_j``.
+    follows faces ``(v, p_j, p_{j+1})`` from ``p_0 = A[start[v]]`` (an open fan: from the face
+    after its opening, ``p_0 … p_k``). Smooth: position ``(1 − k w) v + w Σ p_j``,
+    ``w = w_table[region, k]`` (region 1: Loop faces), normal ``t1 × t2``, ``t1 = Σ
+    cos_table[k, j] p_j``, ``t2 = Σ sin_table[k, j] p_j``. Crease (``crease_count[v]`` 2
+    infinitely sharp creases to ``crease_nb[v]``, or an open fan and none): position
+    ``crease_mask[0] v + crease_mask[1] (a + b)``, ``a``, ``b`` the crease's (boundary's)
+    neighbours; each sector's normal by :func:`_sector_normal` (``across[m]``: the across
+    mask's centre and end weights of a sector of ``m`` faces, ``sin_half[m, j] = sin(πj/m)``),
+    the vertex's the normalized mean of its two sectors', or with ``one_side`` the one of the
+    sector from the first crease neighbour counter-clockwise from ``p_0`` (OpenSubdiv's side).
     Returns ``(P, N, done)``: ``done`` False where the vertex is left to the general path
-    (tagged, mixed faces, a boundary or a second fan, valence ≥ the tables' size, a
-    degenerate tangent pair); P and N are not written there. A vertex no face uses is done:
-    its own position, a zero normal. Threaded over the vertices (``smooth_vertex_limits``;
-    ``smooth_vertex_limits_serial`` the same on one thread: each vertex is its own sums).
+    (tagged otherwise, mixed faces, √3 faces at a crease, two fans, valence ≥ the tables'
+    size, a degenerate tangent pair, sectors that cancel); P and N are not written there. A
+    vertex no face uses is done: its own position, a zero normal. Threaded over the vertices
+    (``vertex_limits``; ``vertex_limits_serial`` the same on one thread: each vertex is its
+    own sums).
     """
     n = start.shape[0] - 1
     kmax = cos_table.shape[0]
     P = np.empty((n, 3))
     N = np.zeros((n, 3))
     done = np.zeros(n, np.bool_)
+    ring = np.empty(A.shape[0] + n, A.dtype)  # crease vertex v's ring at start[v] + v, k + 1 entries at most
     for v in prange(n):
         lo = start[v]
         k = start[v + 1] - lo
@@ -71,7 +164,7 @@ def _smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, co
             P[v, 0], P[v, 1], P[v, 2] = X[v, 0], X[v, 1], X[v, 2]
             done[v] = True
             continue
-        if blocked[v] or k >= kmax:
+        if blocked[v] or k + 1 >= kmax:
             continue
         n_sharp = 0
         for t in range(lo, lo + k):
@@ -79,61 +172,132 @@ def _smooth_vertex_limits(start, A, B, face, X, blocked, face_sharp, w_table, co
         if n_sharp != 0 and n_sharp != k:
             continue
         region = 1 if n_sharp == k else 0
-        first = A[lo]
-        cur = B[lo]
-        x, y, z = X[first, 0], X[first, 1], X[first, 2]
-        sx, sy, sz = x, y, z
-        c = cos_table[k, 0]
-        s = sin_table[k, 0]
-        ax, ay, az = c * x, c * y, c * z
-        bx, by, bz = s * x, s * y, s * z
-        closed = True
-        for j in range(1, k):
-            if cur == first:  # back at the start early: a second fan
-                closed = False
-                break
-            found = -1
-            for t in range(lo + 1, lo + k):
-                if A[t] == cur:
-                    found = t
+        cc = crease_count[v]
+        if cc == 0:  # smooth, unless the fan turns out open: the sums along the walk
+            first = A[lo]
+            cur = B[lo]
+            x, y, z = X[first, 0], X[first, 1], X[first, 2]
+            sx, sy, sz = x, y, z
+            c = cos_table[k, 0]
+            s = sin_table[k, 0]
+            ax, ay, az = c * x, c * y, c * z
+            bx, by, bz = s * x, s * y, s * z
+            state = 1  # 1: closed, 0: two fans, −1: open
+            for j in range(1, k):
+                if cur == first:
+                    state = 0
                     break
-            if found < 0:  # the fan is open: a boundary
-                closed = False
-                break
-            x, y, z = X[cur, 0], X[cur, 1], X[cur, 2]
-            sx += x
-            sy += y
-            sz += z
-            c = cos_table[k, j]
-            s = sin_table[k, j]
-            ax += c * x
-            ay += c * y
-            az += c * z
-            bx += s * x
-            by += s * y
-            bz += s * z
-            cur = B[found]
-        if not closed or cur != first:
-            continue
-        if want_normals:
-            nx = ay * bz - az * by
-            ny = az * bx - ax * bz
-            nz = ax * by - ay * bx
-            size = np.sqrt(nx * nx + ny * ny + nz * nz)
-            scale = np.sqrt(ax * ax + ay * ay + az * az) * np.sqrt(bx * bx + by * by + bz * bz)
-            if not size > 1e-12 * scale:
+                found = -1
+                for t in range(lo + 1, lo + k):
+                    if A[t] == cur:
+                        found = t
+                        break
+                if found < 0:
+                    state = -1
+                    break
+                x, y, z = X[cur, 0], X[cur, 1], X[cur, 2]
+                sx += x
+                sy += y
+                sz += z
+                c = cos_table[k, j]
+                s = sin_table[k, j]
+                ax += c * x
+                ay += c * y
+                az += c * z
+                bx += s * x
+                by += s * y
+                bz += s * z
+                cur = B[found]
+            if state == 1 and cur != first:
+                state = 0
+            if state == 0:
                 continue
-            N[v, 0], N[v, 1], N[v, 2] = nx / size, ny / size, nz / size
-        w = w_table[region, k]
-        c0 = 1.0 - k * w
-        P[v, 0] = c0 * X[v, 0] + w * sx
-        P[v, 1] = c0 * X[v, 1] + w * sy
-        P[v, 2] = c0 * X[v, 2] + w * sz
+            if state == 1:
+                if want_normals:
+                    nx = ay * bz - az * by
+                    ny = az * bx - ax * bz
+                    nz = ax * by - ay * bx
+                    size = np.sqrt(nx * nx + ny * ny + nz * nz)
+                    scale = np.sqrt(ax * ax + ay * ay + az * az) * np.sqrt(bx * bx + by * by + bz * bz)
+                    if not size > 1e-12 * scale:
+                        continue
+                    N[v, 0], N[v, 1], N[v, 2] = nx / size, ny / size, nz / size
+                w = w_table[region, k]
+                c0 = 1.0 - k * w
+                P[v, 0] = c0 * X[v, 0] + w * sx
+                P[v, 1] = c0 * X[v, 1] + w * sy
+                P[v, 2] = c0 * X[v, 2] + w * sz
+                done[v] = True
+                continue
+        if region != 1:
+            continue
+        off = lo + v
+        m, closed = _fan(start, A, B, v, ring, off)
+        if m == 0:
+            continue
+        if region != 1 or not ((closed and cc == 2) or (not closed and cc == 0)):
+            continue
+        if closed:
+            i1 = i2 = -1
+            for j in range(k):
+                p = ring[off + j]
+                if p == crease_nb[v, 0] or p == crease_nb[v, 1]:
+                    if i1 < 0:
+                        i1 = j
+                    else:
+                        i2 = j
+            if i2 < 0:
+                continue
+            a, b = ring[off + i1], ring[off + i2]
+        else:
+            a, b = ring[off], ring[off + k]
+        if want_normals:
+            if closed:
+                x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, i1, i2 - i1, k, across, sin_half)
+                x2, y2, z2, ok2 = _sector_normal(X, v, ring, off, i2, k - (i2 - i1), k, across, sin_half)
+                if not (ok1 and ok2):
+                    continue
+                if one_side:
+                    N[v, 0], N[v, 1], N[v, 2] = x1, y1, z1
+                else:
+                    sx, sy, sz = x1 + x2, y1 + y2, z1 + z2
+                    size = np.sqrt(sx * sx + sy * sy + sz * sz)
+                    if size < 1e-6:  # sectors facing opposite ways (a fin)
+                        continue
+                    N[v, 0], N[v, 1], N[v, 2] = sx / size, sy / size, sz / size
+            else:
+                x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, 0, k, k + 1, across, sin_half)
+                if not ok1:
+                    continue
+                N[v, 0], N[v, 1], N[v, 2] = x1, y1, z1
+        c0, c1 = crease_mask[0], crease_mask[1]
+        P[v, 0] = c0 * X[v, 0] + c1 * (X[a, 0] + X[b, 0])
+        P[v, 1] = c0 * X[v, 1] + c1 * (X[a, 1] + X[b, 1])
+        P[v, 2] = c0 * X[v, 2] + c1 * (X[a, 2] + X[b, 2])
         done[v] = True
     return P, N, done
 
 
-smooth_vertex_limits, smooth_vertex_limits_serial = threaded_and_serial(_smooth_vertex_limits)
+vertex_limits, vertex_limits_serial = threaded_and_serial(_vertex_limits)
+
+
+@kernel
+def crease_neighbours(pairs, sharpness, n):
+    """Per vertex: how many infinitely sharp creases of ``pairs`` meet it (an edge listed twice
+    counted once), and the far ends of the first two (−1: none)."""
+    count = np.zeros(n, np.int64)
+    nb = np.full((n, 2), -1, np.int64)
+    for r in range(pairs.shape[0]):
+        if not np.isinf(sharpness[r]):
+            continue
+        for e in range(2):
+            u, w = pairs[r, e], pairs[r, 1 - e]
+            if nb[u, 0] == w or nb[u, 1] == w:
+                continue
+            if count[u] < 2:
+                nb[u, count[u]] = w
+            count[u] += 1
+    return count, nb
 
 
 @kernel
@@ -144,3 +308,30 @@ def faces_around(start, face, vertices, n_faces):
         for t in range(start[v], start[v + 1]):
             out[face[t]] = True
     return out
+
+
+@kernel
+def compact_faces(F, faces, n):
+    """The faces ``F[faces]`` (``faces`` a mask) over their own vertices, numbered in order of
+    first use: returns ``(local faces (k, 3), used (u,), local (n,))``, ``used[j]`` the vertex
+    numbered ``j``, ``local[v]`` the number of vertex ``v`` (−1: not used)."""
+    local = np.full(n, -1, np.int64)
+    k = 0
+    for f in range(faces.shape[0]):
+        k += faces[f]
+    out = np.empty((k, 3), np.int64)
+    used = np.empty(3 * k, np.int64)
+    u = 0
+    r = 0
+    for f in range(faces.shape[0]):
+        if not faces[f]:
+            continue
+        for i in range(3):
+            v = F[f, i]
+            if local[v] < 0:
+                local[v] = u
+                used[u] = v
+                u += 1
+            out[r, i] = local[v]
+        r += 1
+    return out, used[:u].copy(), local

@@ -14,6 +14,7 @@ from .._input import RefineInput, open_gate
 from .._topology import Level, build_level
 from .._refiner import refinement_of, walk_to
 from .._refiner.refinement import _level_corners, level_holes
+from ._vertex_kernels import compact_faces
 from .mask_plan import edge_sharpness
 
 
@@ -171,27 +172,24 @@ def with_halfedges(li: LimitInput) -> LimitSetup:
                       li.hole)
 
 
-def local_setup(li: LimitInput, faces: np.ndarray, degree: np.ndarray) -> tuple[LimitSetup, np.ndarray]:
+def local_setup(li: LimitInput, faces: np.ndarray, degree: np.ndarray) -> tuple[LimitSetup, np.ndarray, np.ndarray]:
     """The faces ``faces`` (a mask) of ``li`` apart, as a setup of their own vertices.
 
-    Returns the setup and the vertices it numbers 0, 1, … (their ids in ``li``). ``degree``
-    (n,): the number of faces of each vertex in ``li``. The tags kept are those of edges with
-    an end at a vertex all of whose faces are kept: the classification, masks and local
-    refinement of exactly those vertices are the ones of the whole level, which is all the
-    caller may use.
+    Returns the setup, the vertices it numbers 0, 1, … (their ids in ``li``) and the number
+    of every vertex of ``li`` there (−1: not in it). ``degree`` (n,): the number of faces of
+    each vertex in ``li``. The tags kept are those of edges with an end at a vertex all of
+    whose faces are kept: the classification, masks and local refinement of exactly those
+    vertices are the ones of the whole level, which is all the caller may use.
     """
-    used, inv = np.unique(li.faces[faces], return_inverse=True)
-    F = inv.reshape(-1, 3).astype(np.int64)
+    F, used, local = compact_faces(li.faces, faces, li.n_vertices)
     n = len(used)
-    local = np.full(li.n_vertices, -1, dtype=np.int64)
-    local[used] = np.arange(n)
     whole = np.bincount(F.ravel(), minlength=n) == degree[used]
     lp = local[li.pairs] if len(li.pairs) else np.zeros((0, 2), np.int64)
     keep = (lp >= 0).all(axis=1) & whole[np.maximum(lp, 0)].any(axis=1)
     level = build_level(F, n)
     tagged, esharp = edge_sharpness(level, lp[keep], li.sharpness[keep], li.scheme)
     setup = LimitSetup(level, tagged, esharp, li.face_sharp[faces], li.corner[used], li.refinement, n, True)
-    return setup, used
+    return setup, used, local
 
 
 def setup_limit(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,

@@ -56,11 +56,13 @@ def semi_sharp(corner: np.ndarray) -> np.ndarray:
     return (corner > 0) & np.isfinite(corner)
 
 
-def plan_vertices(level: Level, esharp, face_sharp, corner: np.ndarray, scheme: str, loop_weights: str) -> LimitPlan:
+def plan_vertices(level: Level, esharp, face_sharp, corner: np.ndarray, scheme: str, loop_weights: str,
+                  only: np.ndarray | None = None) -> LimitPlan:
     """:func:`plan_level` where ``corner`` may be vertex sharpness (float64): a semi-sharp
     vertex (finite sharpness left) has no stationary limit mask (it moves once its sharpness is
-    spent), so it is left out of the plan's rows and marked unsettled, to be refined locally."""
-    plan = plan_level(level, esharp, face_sharp, corner_mask(corner), scheme, loop_weights)
+    spent), so it is left out of the plan's rows and marked unsettled, to be refined locally.
+    ``only``: as for :func:`plan_level`."""
+    plan = plan_level(level, esharp, face_sharp, corner_mask(corner), scheme, loop_weights, only)
     semi = semi_sharp(corner)
     if not semi.any():
         return plan

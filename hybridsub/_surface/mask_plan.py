@@ -9,6 +9,7 @@ semi-sharp; a sector has stationary tangent masks by its kind (``SEC_*``). Every
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -78,7 +79,7 @@ def edge_sharpness(level: Level, pairs: np.ndarray, sharpness: np.ndarray, schem
 
 
 def plan_level(level: Level, esharp: np.ndarray, face_sharp: np.ndarray, corner: np.ndarray, scheme: str,
-               loop_weights: str) -> LimitPlan:
+               loop_weights: str, only: np.ndarray | None = None) -> LimitPlan:
     """Classify every vertex and sector of ``level`` and gather their stationary masks.
 
     Parameters
@@ -93,6 +94,9 @@ def plan_level(level: Level, esharp: np.ndarray, face_sharp: np.ndarray, corner:
         Tagged corners.
     scheme, loop_weights
         As for :func:`hybridsub.refine`.
+    only : (n,) array of bool, optional
+        Gather masks for these vertices only: the others are classified (``pos_ok``) but get
+        no rows, and their sectors are ``SEC_FAN`` (no tangent masks).
 
     Returns
     -------
@@ -110,8 +114,13 @@ def plan_level(level: Level, esharp: np.ndarray, face_sharp: np.ndarray, corner:
     """
     sec = vertex_sectors(level, esharp > 0)
     vc = _classify(level, sec, esharp, face_sharp, corner, scheme, loop_weights)
+    if only is not None:
+        vc = dataclasses.replace(vc, corner=vc.corner & only, crease=vc.crease & only, smooth=vc.smooth & only,
+                                 dart=vc.dart & only)
     rows = _limit_rows(level, sec, vc, esharp, scheme, loop_weights)
     kind = _sector_kinds(sec, vc, face_sharp, scheme)
+    if only is not None:
+        kind[~only[sec.vertex]] = SEC_FAN
     return LimitPlan(sec, vc.pos_ok, vc.settled, rows, kind, loop_weights)
 
 

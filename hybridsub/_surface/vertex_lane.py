@@ -1,11 +1,12 @@
 """The vertex lane: limit positions and normals of a whole level without a plan of every
 vertex.
 
-Almost every vertex of a refined level is smooth: one closed fan of faces of one kind, no
-tag. Those get their limit position and normal from their ring in one kernel pass
-(``_vertex_kernels``), with the weights of the scheme's rules (``_rules.limit``) tabulated by
-valence. The rest — creases, corners, boundaries, darts, vertices between √3 and Loop faces —
-go through the general evaluation (``level_eval``: the plan, its masks, local refinement
+Almost every vertex of a refined level is smooth (one closed fan of faces of one kind, no
+tag) or on a crease or the boundary among Loop faces. Those get their limit position and
+normal from their ring in one kernel pass (``_vertex_kernels``), with the weights of the
+scheme's rules (``_rules.limit``) tabulated by valence and sector size. The rest — corners,
+darts, semi-sharp creases, vertices between √3 and Loop faces, √3 faces at a crease or
+Kobbelt's boundary — go through the general evaluation (``level_eval``: the plan, its masks, local refinement
 where a vertex has none) on just the faces around them, which is all their masks and local
 refinement read.
 """
@@ -30,16 +31,22 @@ MAX_LANE_VALENCE = 64
 
 
 @functools.lru_cache(maxsize=None)
-def _tables(loop_weights: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The smooth limit weight per (region, valence) and the tangent weights per (valence, j)."""
+def _tables(loop_weights: str) -> tuple:
+    """The rules' weights by valence and sector size (:func:`_vertex_kernels.vertex_limits`):
+    the smooth limit weight per (region, valence), the smooth tangent weights per (valence, j),
+    the crease limit mask, the Loop crease sector's across weights (centre, ends) per size and
+    its interior weights sin(πj/m)."""
     k = np.arange(MAX_LANE_VALENCE)
     w = np.stack([LR.smooth_limit_weight(k, np.full(len(k), R.REGION_SQRT3), loop_weights),
                   LR.smooth_limit_weight(k, np.full(len(k), R.REGION_LOOP), loop_weights)])
     kk, jj = np.meshgrid(np.maximum(k, 1), k, indexing="ij")
     c, s = LR.smooth_tangent_weights(kk, jj)
-    for a in (w, c, s):
-        a.flags.writeable = False
-    return w, np.ascontiguousarray(c), np.ascontiguousarray(s)
+    a, b = LR.sector_across_weights(np.maximum(k, 1), "loop")
+    out = (w, np.ascontiguousarray(c), np.ascontiguousarray(s), np.array(LR.CREASE_LIMIT_MASK),
+           np.ascontiguousarray(np.stack([a, b], axis=1)), np.ascontiguousarray(np.sin(np.pi * jj / kk)))
+    for t in out:
+        t.flags.writeable = False
+    return out
 
 
 def _corner_slots(F: np.ndarray, n: int):
@@ -50,15 +57,21 @@ def _corner_slots(F: np.ndarray, n: int):
     return VK.corner_slots(F, n, A, B, face), A, B, face
 
 
-def _blocked(li: LimitInput) -> np.ndarray:
-    """(n,) vertices the smooth rule cannot take for their tags: an end of a tagged edge, or a
-    tagged corner ("sqrt3" ignores both: only its boundary is sharp)."""
-    blocked = np.zeros(li.n_vertices, dtype=bool)
-    if li.scheme == "sqrt3":
-        return blocked
+def _tags(li: LimitInput) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(n,) vertices the lane cannot take for their tags (a tagged corner, an end of a
+    semi-sharp crease), and per vertex the infinitely sharp creases at it and their far ends
+    (``_vertex_kernels.crease_neighbours``); "sqrt3" has none of them (only its boundary is
+    sharp)."""
+    n = li.n_vertices
+    blocked = np.zeros(n, dtype=bool)
     pairs, sharpness = li.tag_pairs()
-    blocked[pairs[sharpness > 0].ravel()] = True
-    return blocked | (li.corner > 0)
+    if li.scheme == "sqrt3" or not len(pairs):
+        return blocked | (li.corner > 0) if li.scheme != "sqrt3" else blocked, np.zeros(n, np.int64), \
+            np.full((n, 2), -1, np.int64)
+    blocked[pairs[(sharpness > 0) & np.isfinite(sharpness)].ravel()] = True
+    count, nb = VK.crease_neighbours(np.ascontiguousarray(pairs, dtype=np.int64),
+                                     np.ascontiguousarray(sharpness, dtype=np.float64), n)
+    return blocked | (li.corner > 0), count, nb
 
 
 def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_positions: bool, want_normals: bool,
@@ -86,18 +99,19 @@ def level_limits(li: LimitInput, X: np.ndarray, loop_weights: str, want_position
     n = li.n_vertices
     X = np.ascontiguousarray(X, dtype=np.float64)
     start, A, B, face = _corner_slots(F, n)
-    w, c, s = _tables(loop_weights)
-    lane = VK.smooth_vertex_limits if use_threads(n) else VK.smooth_vertex_limits_serial
-    P, N, done = lane(start, A, B, face, X, _blocked(li), li.face_sharp.view(np.uint8), w, c, s,
-                                         want_normals)
+    w, c, s, crease, across, half = _tables(loop_weights)
+    blocked, count, nb = _tags(li)
+    lane = VK.vertex_limits if use_threads(n) else VK.vertex_limits_serial
+    P, N, done = lane(start, A, B, face, X, blocked, count, nb, li.face_sharp.view(np.uint8), w, c, s, crease, across,
+                      half, want_normals, crease_normals == "one_side")
     G = np.flatnonzero(~done)
     if len(G):
-        sub, used = local_setup(li, VK.faces_around(start, face, G, len(F)), np.diff(start))
+        sub, used, local = local_setup(li, VK.faces_around(start, face, G, len(F)), np.diff(start))
         Xs = X[used]
-        g = np.searchsorted(used, G)
+        g = local[G]
         at_g = np.zeros(len(used), dtype=bool)
         at_g[g] = True
-        plan = plan_vertices(sub.level, sub.esharp, sub.face_sharp, sub.corner, li.scheme, loop_weights)
+        plan = plan_vertices(sub.level, sub.esharp, sub.face_sharp, sub.corner, li.scheme, loop_weights, at_g)
         if want_positions:
             L, _, _ = evaluate_level(sub, li.scheme, loop_weights, None, True, tol, max_levels, only=at_g, plan=plan)
             P[G] = L[g] @ Xs
