@@ -120,6 +120,12 @@ def test_limit_mesh_bad_input():
         hybridsub.limit_mesh(V, F, crease_normals="left")
     with pytest.raises(ValueError, match="tol"):
         hybridsub.limit_mesh(V, F, normal_tol=0)
+    with pytest.raises(TypeError, match="normals"):
+        hybridsub.limit_mesh(V, F, normals="yes")
+    with pytest.raises(hybridsub.MeshError, match="vertex 9"):
+        hybridsub.limit_mesh(V, [[0, 1, 9]])
+    with pytest.raises(hybridsub.MeshError, match="non-finite"):
+        hybridsub.limit_mesh(np.where(np.arange(len(V))[:, None] == 1, np.nan, V), F)
     with pytest.raises(ValueError):
         hybridsub.limit_mesh(V[:, :2], F)
     with pytest.raises(ValueError, match="levels"):

@@ -320,6 +320,8 @@ def limit_mesh(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = None,
     True
     """
     _check_crease_normals(crease_normals)
+    if not isinstance(normals, (bool, np.bool_)):
+        raise TypeError(f"normals must be True or False, got {normals!r}")
     A = np.asarray(V)
     Vf = as_vertices(A)
     tol, max_levels = _check_tol(tol, max_levels)
