@@ -71,6 +71,10 @@ class Grow:
     def a(self) -> np.ndarray:
         return self._a[:self.n]
 
+    @property
+    def capacity_bytes(self) -> int:
+        return self._a.nbytes
+
 
 def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np.ndarray, fstart: np.ndarray):
     """Canonical orders and key records of the pieces of ``level`` (node ``i``: faces
@@ -159,8 +163,9 @@ class PatchTable:
 
     @property
     def nbytes(self) -> int:
-        """What the cache holds (its two dictionaries estimated)."""
-        grown = sum(g.a.nbytes for g in vars(self).values() if isinstance(g, Grow))
+        """What the cache holds: its arrays' capacity (they grow by half), its two dictionaries
+        estimated."""
+        grown = sum(g.capacity_bytes for g in vars(self).values() if isinstance(g, Grow))
         return grown + 120 * (len(self.index) + len(self._t_index)) + self._t_key_bytes
 
     @property

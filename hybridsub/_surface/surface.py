@@ -20,7 +20,7 @@ from .walk import StartKeys, walk_points, walk_rows
 #: Points followed down together (bounds the memory of one pass).
 CHUNK = 20000
 #: The patch cache is emptied between chunks once it holds about this many bytes.
-CACHE_BYTES = 2**29
+CACHE_BYTES = 2**28
 
 
 def _default_depth(scheme: str) -> int:
