@@ -56,7 +56,7 @@ class Grow:
         block = np.asarray(block, self._a.dtype)
         start, end = self.n, self.n + len(block)
         if end > len(self._a):
-            new = np.full((max(len(self._a) * 3 // 2, end),) + self._a.shape[1:], self.fill, self._a.dtype)
+            new = np.empty((max(len(self._a) * 3 // 2, end),) + self._a.shape[1:], self._a.dtype)  # read to n only
             new[:self.n] = self._a[:self.n]
             self._a = new
         self._a[start:end] = block
