@@ -167,3 +167,16 @@ def test_limit_mesh_with_semi_sharp_corners(scheme):
     assert np.abs(full.vertices - P).max() <= 1e-12 * np.linalg.norm(V.max(0) - V.min(0))
     assert np.array_equal(full.normals, hybridsub.limit_normals(V, F, levels=1, **kw))
     assert np.array_equal(full.faces, hybridsub.subdivide(V, F, **kw)[1])
+
+
+def test_one_thread_and_all_give_the_same_bits():
+    V, F = _load("fandisk")
+    tags = _tags(V, F, "creases")
+    assert len(hybridsub.refine(F, levels=2, scheme="loop", **tags).apply(V)) >= 65536  # the threaded twin's size
+    many = hybridsub.limit_mesh(V, F, levels=2, scheme="loop", **tags)
+    try:
+        hybridsub.set_threads(1)
+        one = hybridsub.limit_mesh(V, F, levels=2, scheme="loop", **tags)
+    finally:
+        hybridsub.set_threads()
+    assert np.array_equal(one.vertices, many.vertices) and np.array_equal(one.normals, many.normals)
