@@ -7,6 +7,8 @@ applies where; the matrix layer turns the weights into rows of S.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -123,7 +125,13 @@ def smooth_weight_table(max_valence, loop_weights="loop"):
     >>> t.shape, float(t[REGION_LOOP, 6])
     ((3, 7), 0.0625)
     """
-    n = np.arange(max_valence + 1)
+    size = max(32, 1 << int(max_valence).bit_length())  # tables of a few sizes, each computed once
+    return _weight_table(size, loop_weights)[:, :max_valence + 1].copy()
+
+
+@functools.lru_cache(maxsize=None)
+def _weight_table(size: int, loop_weights: str) -> np.ndarray:
+    n = np.arange(size + 1)
     return np.stack([smooth_neighbour_weight(n, r, loop_weights)
                      for r in (REGION_SQRT3, REGION_LOOP, REGION_MIXED)])
 
