@@ -117,14 +117,123 @@ def _sector_normal(X, v, ring, off, first, m, wrap, across, sin_half):
         wx += c * X[q, 0]
         wy += c * X[q, 1]
         wz += c * X[q, 2]
-    nx = uy * wz - uz * wy
-    ny = uz * wx - ux * wz
-    nz = ux * wy - uy * wx
+    return _unit_cross(ux, uy, uz, wx, wy, wz)
+
+
+@kernel(inline="always")
+def _unit_cross(ax, ay, az, bx, by, bz):
+    """``a × b`` normalised, and False where it is degenerate (under 1e-12 of ``|a| |b|``)."""
+    nx = ay * bz - az * by
+    ny = az * bx - ax * bz
+    nz = ax * by - ay * bx
     size = np.sqrt(nx * nx + ny * ny + nz * nz)
-    scale = np.sqrt(ux * ux + uy * uy + uz * uz) * np.sqrt(wx * wx + wy * wy + wz * wz)
+    scale = np.sqrt(ax * ax + ay * ay + az * az) * np.sqrt(bx * bx + by * by + bz * bz)
     if not size > 1e-12 * scale:
         return 0.0, 0.0, 0.0, False
     return nx / size, ny / size, nz / size, True
+
+
+@kernel(inline="always")
+def _smooth(start, A, B, X, v, region, w_table, cos_table, sin_table, want_normals, P, N):
+    """The smooth rule at ``v``, its ring's sums taken along the walk from ``A[start[v]]``:
+    1 (``P[v]``, ``N[v]`` written), 0 (two fans, or a degenerate tangent pair: the general
+    path's) or −1 (the fan is open: a boundary vertex)."""
+    lo = start[v]
+    k = start[v + 1] - lo
+    first = A[lo]
+    cur = B[lo]
+    x, y, z = X[first, 0], X[first, 1], X[first, 2]
+    sx, sy, sz = x, y, z
+    c = cos_table[k, 0]
+    s = sin_table[k, 0]
+    ax, ay, az = c * x, c * y, c * z
+    bx, by, bz = s * x, s * y, s * z
+    for j in range(1, k):
+        if cur == first:  # back at the start early: a second fan
+            return 0
+        found = -1
+        for t in range(lo + 1, lo + k):
+            if A[t] == cur:
+                found = t
+                break
+        if found < 0:
+            return -1
+        x, y, z = X[cur, 0], X[cur, 1], X[cur, 2]
+        sx += x
+        sy += y
+        sz += z
+        c = cos_table[k, j]
+        s = sin_table[k, j]
+        ax += c * x
+        ay += c * y
+        az += c * z
+        bx += s * x
+        by += s * y
+        bz += s * z
+        cur = B[found]
+    if cur != first:
+        return 0
+    if want_normals:
+        nx, ny, nz, ok = _unit_cross(ax, ay, az, bx, by, bz)
+        if not ok:
+            return 0
+        N[v, 0], N[v, 1], N[v, 2] = nx, ny, nz
+    w = w_table[region, k]
+    c0 = 1.0 - k * w
+    P[v, 0] = c0 * X[v, 0] + w * sx
+    P[v, 1] = c0 * X[v, 1] + w * sy
+    P[v, 2] = c0 * X[v, 2] + w * sz
+    return 1
+
+
+@kernel(inline="always")
+def _crease(start, A, B, X, v, cc, crease_nb, crease_mask, across, sin_half, want_normals, one_side, ring, P, N):
+    """The crease rule at ``v`` among Loop faces (two creases through a closed fan, or the
+    boundary of an open one with none): True with ``P[v]``, ``N[v]`` written, False where
+    ``v`` is none of these or its normal is degenerate (the general path's). Its ring goes to
+    ``ring[start[v] + v:]``."""
+    lo = start[v]
+    k = start[v + 1] - lo
+    off = lo + v
+    m, closed = _fan(start, A, B, v, ring, off)
+    if m == 0 or not ((closed and cc == 2) or (not closed and cc == 0)):
+        return False
+    i1 = i2 = -1
+    if closed:
+        for j in range(k):
+            p = ring[off + j]
+            if p == crease_nb[v, 0] or p == crease_nb[v, 1]:
+                if i1 < 0:
+                    i1 = j
+                else:
+                    i2 = j
+        if i2 < 0:
+            return False
+        a, b = ring[off + i1], ring[off + i2]
+    else:
+        a, b = ring[off], ring[off + k]
+    if want_normals:
+        if closed:
+            x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, i1, i2 - i1, k, across, sin_half)
+            x2, y2, z2, ok2 = _sector_normal(X, v, ring, off, i2, k - (i2 - i1), k, across, sin_half)
+            if not (ok1 and ok2):
+                return False
+            if not one_side:
+                x1, y1, z1 = x1 + x2, y1 + y2, z1 + z2
+                size = np.sqrt(x1 * x1 + y1 * y1 + z1 * z1)
+                if size < 1e-6:  # sectors facing opposite ways (a fin)
+                    return False
+                x1, y1, z1 = x1 / size, y1 / size, z1 / size
+        else:
+            x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, 0, k, k + 1, across, sin_half)
+            if not ok1:
+                return False
+        N[v, 0], N[v, 1], N[v, 2] = x1, y1, z1
+    c0, c1 = crease_mask[0], crease_mask[1]
+    P[v, 0] = c0 * X[v, 0] + c1 * (X[a, 0] + X[b, 0])
+    P[v, 1] = c0 * X[v, 1] + c1 * (X[a, 1] + X[b, 1])
+    P[v, 2] = c0 * X[v, 2] + c1 * (X[a, 2] + X[b, 2])
+    return True
 
 
 def _vertex_limits(start, A, B, face, X, blocked, crease_count, crease_nb, face_sharp, w_table, cos_table, sin_table,
@@ -173,108 +282,15 @@ def _vertex_limits(start, A, B, face, X, blocked, crease_count, crease_nb, face_
             continue
         region = 1 if n_sharp == k else 0
         cc = crease_count[v]
-        if cc == 0:  # smooth, unless the fan turns out open: the sums along the walk
-            first = A[lo]
-            cur = B[lo]
-            x, y, z = X[first, 0], X[first, 1], X[first, 2]
-            sx, sy, sz = x, y, z
-            c = cos_table[k, 0]
-            s = sin_table[k, 0]
-            ax, ay, az = c * x, c * y, c * z
-            bx, by, bz = s * x, s * y, s * z
-            state = 1  # 1: closed, 0: two fans, −1: open
-            for j in range(1, k):
-                if cur == first:
-                    state = 0
-                    break
-                found = -1
-                for t in range(lo + 1, lo + k):
-                    if A[t] == cur:
-                        found = t
-                        break
-                if found < 0:
-                    state = -1
-                    break
-                x, y, z = X[cur, 0], X[cur, 1], X[cur, 2]
-                sx += x
-                sy += y
-                sz += z
-                c = cos_table[k, j]
-                s = sin_table[k, j]
-                ax += c * x
-                ay += c * y
-                az += c * z
-                bx += s * x
-                by += s * y
-                bz += s * z
-                cur = B[found]
-            if state == 1 and cur != first:
-                state = 0
-            if state == 0:
-                continue
+        if cc == 0:  # smooth, unless the fan turns out open
+            state = _smooth(start, A, B, X, v, region, w_table, cos_table, sin_table, want_normals, P, N)
             if state == 1:
-                if want_normals:
-                    nx = ay * bz - az * by
-                    ny = az * bx - ax * bz
-                    nz = ax * by - ay * bx
-                    size = np.sqrt(nx * nx + ny * ny + nz * nz)
-                    scale = np.sqrt(ax * ax + ay * ay + az * az) * np.sqrt(bx * bx + by * by + bz * bz)
-                    if not size > 1e-12 * scale:
-                        continue
-                    N[v, 0], N[v, 1], N[v, 2] = nx / size, ny / size, nz / size
-                w = w_table[region, k]
-                c0 = 1.0 - k * w
-                P[v, 0] = c0 * X[v, 0] + w * sx
-                P[v, 1] = c0 * X[v, 1] + w * sy
-                P[v, 2] = c0 * X[v, 2] + w * sz
                 done[v] = True
+            if state >= 0:
                 continue
-        if region != 1:
-            continue
-        off = lo + v
-        m, closed = _fan(start, A, B, v, ring, off)
-        if m == 0:
-            continue
-        if region != 1 or not ((closed and cc == 2) or (not closed and cc == 0)):
-            continue
-        if closed:
-            i1 = i2 = -1
-            for j in range(k):
-                p = ring[off + j]
-                if p == crease_nb[v, 0] or p == crease_nb[v, 1]:
-                    if i1 < 0:
-                        i1 = j
-                    else:
-                        i2 = j
-            if i2 < 0:
-                continue
-            a, b = ring[off + i1], ring[off + i2]
-        else:
-            a, b = ring[off], ring[off + k]
-        if want_normals:
-            if closed:
-                x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, i1, i2 - i1, k, across, sin_half)
-                x2, y2, z2, ok2 = _sector_normal(X, v, ring, off, i2, k - (i2 - i1), k, across, sin_half)
-                if not (ok1 and ok2):
-                    continue
-                if one_side:
-                    N[v, 0], N[v, 1], N[v, 2] = x1, y1, z1
-                else:
-                    sx, sy, sz = x1 + x2, y1 + y2, z1 + z2
-                    size = np.sqrt(sx * sx + sy * sy + sz * sz)
-                    if size < 1e-6:  # sectors facing opposite ways (a fin)
-                        continue
-                    N[v, 0], N[v, 1], N[v, 2] = sx / size, sy / size, sz / size
-            else:
-                x1, y1, z1, ok1 = _sector_normal(X, v, ring, off, 0, k, k + 1, across, sin_half)
-                if not ok1:
-                    continue
-                N[v, 0], N[v, 1], N[v, 2] = x1, y1, z1
-        c0, c1 = crease_mask[0], crease_mask[1]
-        P[v, 0] = c0 * X[v, 0] + c1 * (X[a, 0] + X[b, 0])
-        P[v, 1] = c0 * X[v, 1] + c1 * (X[a, 1] + X[b, 1])
-        P[v, 2] = c0 * X[v, 2] + c1 * (X[a, 2] + X[b, 2])
-        done[v] = True
+        if region == 1 and _crease(start, A, B, X, v, cc, crease_nb, crease_mask, across, sin_half, want_normals,
+                                   one_side, ring, P, N):
+            done[v] = True
     return P, N, done
 
 
