@@ -94,6 +94,8 @@ def _uvs() -> None:
 
 
 def _limits() -> None:
+    import numba
+
     import hybridsub
 
     V, F = _mesh()
@@ -103,6 +105,8 @@ def _limits() -> None:
         hybridsub.limit_positions(V, F, levels=1, **kw)
         hybridsub.limit_normals(V, F, levels=1, **kw)
         hybridsub.limit_matrix(F, levels=1, **kw)
+    if numba.config.NUMBA_NUM_THREADS > 1:  # the vertex lane's threaded twin: above 65,536 vertices
+        hybridsub.limit_mesh(V, F, edges, levels=2, scheme="loop", corners=corners)
 
 
 def _surface() -> None:
