@@ -63,7 +63,7 @@ def _agree(li, V, crease_normals):
 def test_lane_equals_the_general_evaluation(name, scheme, kind):
     V, F = _load(name)
     tags = {} if scheme == "sqrt3" else _tags(V, F, kind)
-    for levels in (1, 2):  # the default level, and one where every new vertex is regular
+    for levels in (0, 1, 2):  # the defaults (limit_positions', limit_mesh's), and every new vertex regular
         li = walk_for_limit(V, F, tags.get("sharp_edges"), levels, scheme, tags.get("sharpness"), None,
                             tags.get("corners"), "loop")
         for crease_normals in ("average", "one_side"):
@@ -170,6 +170,9 @@ def test_limit_mesh_with_semi_sharp_corners(scheme):
 
 
 def test_one_thread_and_all_give_the_same_bits():
+    import numba
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread only: no threaded twin to compare")
     V, F = _load("fandisk")
     tags = _tags(V, F, "creases")
     assert len(hybridsub.refine(F, levels=2, scheme="loop", **tags).apply(V)) >= 65536  # the threaded twin's size

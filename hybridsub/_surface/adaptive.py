@@ -20,6 +20,7 @@ from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, Boundary, LoopWeights, NonManifold, Scheme
+from .local import corner_mask, semi_sharp
 from .mask_plan import plan_level
 from .surface import LimitSurface
 from .vertex_limit import limit_positions
@@ -169,10 +170,8 @@ class Criterion:
         all_count = np.bincount(F.ravel(), minlength=n)
         act_count = np.bincount(F[af].ravel(), minlength=n)
         todo = (act_count == all_count) & (act_count > 0) & todo
-        corner = mesh.corner
-        if corner.dtype == np.float64:  # semi-sharp corners: no stationary mask, the surface places them
-            todo &= ~(np.isfinite(corner) & (corner > 0))
-            corner = corner > 0
+        todo &= ~semi_sharp(mesh.corner)  # no stationary mask: the surface places them
+        corner = corner_mask(mesh.corner)
         if not todo.any():
             return none
         ids = np.unique(F[af].ravel())

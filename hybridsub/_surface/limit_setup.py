@@ -44,10 +44,6 @@ class LimitInput:
     refinement: object = None  # the Refinement to the level evaluated, if made
     hole: np.ndarray | None = None  # (m0,) the input's holes (None: none)
 
-    def tag_pairs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The tagged edges of the level evaluated (vertex pairs) and their sharpness."""
-        return self.pairs, self.sharpness
-
 
 @dataclass(frozen=True, eq=False)
 class LimitSetup:

@@ -26,7 +26,8 @@ from .level_eval import evaluate_level
 from .local import plan_vertices
 from .normals import one_side_sectors, sector_normals, vertex_normals
 
-#: Valences the kernel's tables cover; a vertex of higher valence takes the general plan.
+#: Size of the kernel's tables: a vertex of valence MAX_LANE_VALENCE − 1 or more (its open ring needs one
+#: entry more) takes the general plan.
 MAX_LANE_VALENCE = 64
 
 
@@ -64,13 +65,14 @@ def _tags(li: LimitInput) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     sharp)."""
     n = li.n_vertices
     blocked = np.zeros(n, dtype=bool)
-    pairs, sharpness = li.tag_pairs()
-    if li.scheme == "sqrt3" or not len(pairs):
-        return blocked | (li.corner > 0) if li.scheme != "sqrt3" else blocked, np.zeros(n, np.int64), \
-            np.full((n, 2), -1, np.int64)
-    blocked[pairs[(sharpness > 0) & np.isfinite(sharpness)].ravel()] = True
-    count, nb = VK.crease_neighbours(np.ascontiguousarray(pairs, dtype=np.int64),
-                                     np.ascontiguousarray(sharpness, dtype=np.float64), n)
+    count, nb = np.zeros(n, np.int64), np.full((n, 2), -1, np.int64)
+    if li.scheme == "sqrt3":
+        return blocked, count, nb
+    pairs, sharpness = li.pairs, li.sharpness
+    if len(pairs):
+        blocked[pairs[(sharpness > 0) & np.isfinite(sharpness)].ravel()] = True
+        count, nb = VK.crease_neighbours(np.ascontiguousarray(pairs, dtype=np.int64),
+                                         np.ascontiguousarray(sharpness, dtype=np.float64), n)
     return blocked | (li.corner > 0), count, nb
 
 
