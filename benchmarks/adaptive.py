@@ -14,7 +14,7 @@
 
 The tolerance and selective parts run on the default threads, the throughput on one.
 
-    python benchmarks/adaptive.py [--meshes fandisk,cube-meshed] [--quick]
+    python benchmarks/adaptive.py [--meshes fandisk,cube-meshed,mesh_with_border] [--quick]
 """
 
 from __future__ import annotations
@@ -31,7 +31,8 @@ import hybridsub
 from hybridsub._surface.adaptive import adaptive_result, uniform_error
 
 MESHES = {"fandisk": os.path.join(ROOT, "hybridsub", "data", "fandisk.off"),
-          "cube-meshed": os.path.join(ROOT, "tests", "data", "cube-meshed.off")}
+          "cube-meshed": os.path.join(ROOT, "tests", "data", "cube-meshed.off"),
+          "mesh_with_border": os.path.join(ROOT, "tests", "data", "mesh_with_border.off")}  # open: Kobbelt's boundary
 SCHEMES = ("hybrid", "loop", "sqrt3")
 
 

@@ -55,9 +55,14 @@ def uniform_match(V, F, tags, scheme, r, X):
     position, within the same connected piece of the input: pieces may touch at coincident
     vertices); asserts each lies on one, to 1e-12 × the diagonal."""
     tol = 1e-12 * diagonal(V)
+    F0, V0 = F, V
     top = int(r.vertex_level.max(initial=0))
     index = np.full(len(X), -1, np.int64)
     apart = 10.0 * (diagonal(V) + 1.0)
+    if tags.get("non_manifold") == "cut":  # the cut copy's pieces and level 0 (its sheets meet at coincident vertices)
+        from hybridsub._input import open_gate
+        cut = open_gate(F, tags.get("sharp_edges"), 0, n_vertices=len(V), scheme=scheme, non_manifold="cut")
+        F, V0 = cut.faces, V[cut.cut.origin]
     piece = _piece_of_vertices(F, r.faces, r.face_parent, len(X))
     # Holes hide faces and leave the refinement as it is: the uniform vertices' pieces are
     # those of the whole refinement, and a vertex only hidden faces use is not matched.
@@ -69,12 +74,17 @@ def uniform_match(V, F, tags, scheme, r, X):
         if not len(sel):
             continue
         if j:
-            u = hybridsub.refine(F, levels=j, scheme=scheme, n_vertices=len(V), **tags)
+            u = hybridsub.refine(F0, levels=j, scheme=scheme, n_vertices=len(V), **tags)
             U, upiece = u.apply(V), _piece_of_vertices(F, u.faces, u.face_parent, u.n_vertices)
         else:
-            U, upiece = V, _piece_of_vertices(F, F, np.arange(len(F)), len(V))
+            U, upiece = V0, _piece_of_vertices(F, F, np.arange(len(F)), len(V0))
         d, idx = cKDTree(np.column_stack([U, apart * upiece])).query(np.column_stack([X[sel], apart * piece[sel]]))
         assert d.max() <= tol, (j, float(d.max()))
+        # Old vertices keep their indices (refine's layout): where the uniform vertex of the same
+        # index is there too, it is the one (meshes such as elephant-with-holes repeat positions).
+        same = sel < len(V0)
+        at = np.linalg.norm(U[sel[same]] - X[sel[same]], axis=1) <= tol
+        idx[np.flatnonzero(same)[at]] = sel[same][at]
         index[sel] = idx
     return index
 
@@ -110,13 +120,9 @@ def _loops(E):
 def test_region_refinement_is_crack_free_and_exact(mesh, data):
     V, F, tags = mesh
     scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
-    closed = not len(ms.boundary_edges(F))
-    if scheme == "sqrt3":
-        if not closed:
-            scheme = "hybrid"
-        else:
-            tags = {}
-    levels = data.draw(st.integers(0, 3 if len(F) <= 40 else 2))
+    if scheme == "sqrt3":  # Kobbelt's √3 takes no tags; open meshes follow his boundary rule
+        tags = {}
+    levels = data.draw(st.integers(0, 4 if len(F) <= 40 else 3))
     rng = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1)))
     form = data.draw(st.sampled_from(["mask", "indices"]))
     where = rng.random(len(F)) < data.draw(st.sampled_from([0.05, 0.2, 0.5]))
@@ -151,10 +157,7 @@ def test_region_refinement_with_options_is_exact(mesh, data):
     V, F, tags = mesh
     scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
     if scheme == "sqrt3":
-        if len(ms.boundary_edges(F)):
-            scheme = "hybrid"
-        else:
-            tags = {}
+        tags = {}
     tags = _options(data, V, F, tags, scheme)
     levels = data.draw(st.integers(1, 3 if len(F) <= 40 else 2))
     where = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1))).random(len(F)) < 0.3
@@ -185,7 +188,9 @@ def test_region_refinement_with_options_is_exact(mesh, data):
 @given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
 def test_tolerance_with_options_is_exact(mesh, data):
     V, F, tags = mesh
-    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
+    if scheme == "sqrt3":
+        tags = {}
     tags = _options(data, V, F, tags, scheme)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)
@@ -237,12 +242,13 @@ def _book(n=4):
     return V[first], inv.ravel()[F]
 
 
-@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+@pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
 def test_non_manifold_cut_is_exact(scheme):
     # non_manifold="cut" as refine takes it: the region's vertices are the uniform refinement's
-    # of the cut copy; to a tolerance, at the cut copy's limit positions.
+    # of the cut copy; to a tolerance, at the cut copy's limit positions. (√3: the cut edges
+    # are boundary edges of the copy, Kobbelt's boundary rule.)
     V, F = _book()
-    tags = dict(non_manifold="cut", sharp_edges=F[:2, :2])
+    tags = dict(non_manifold="cut", sharp_edges=None if scheme == "sqrt3" else F[:2, :2])
     with pytest.raises(hybridsub.MeshError):
         hybridsub.refine_adaptive(F, where=[0], levels=1, scheme=scheme)
     r = hybridsub.refine_adaptive(F, where=np.arange(12), levels=2, scheme=scheme, **tags)
@@ -258,8 +264,31 @@ def test_non_manifold_cut_is_exact(scheme):
     cut = open_gate(F, tags["sharp_edges"], 0, scheme=scheme, non_manifold="cut")  # the cut copy
     for j in range(int(r.vertex_level.max()) + 1):
         sel = np.flatnonzero(r.vertex_level == j)
-        L = hybridsub.limit_positions(V[cut.cut.origin], cut.faces, cut.sharp_edges, levels=j, scheme=scheme,
-                                      corners=np.flatnonzero(cut.corner))
+        L = hybridsub.limit_positions(V[cut.cut.origin], cut.faces, cut.sharp_edges if len(cut.sharp_edges) else None,
+                                      levels=j, scheme=scheme, corners=np.flatnonzero(cut.corner))
+        d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+        assert d.max(initial=0) <= 1e-9, (j, d.max())
+
+
+@pytest.mark.parametrize("scheme", ["loop", "sqrt3"])
+def test_cut_tolerance_with_edge_and_corner(scheme):
+    # The cut copy's lone boundary vertices are corners (boundary="edge_and_corner"): the
+    # criterion's surface pins them too, so the tolerance is reached, at the limit positions.
+    V, F = _book()
+    tags = dict(non_manifold="cut", boundary="edge_and_corner")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    from hybridsub._input import open_gate
+    cut = open_gate(F, None, 0, scheme=scheme, non_manifold="cut")
+    corners = {} if scheme == "sqrt3" else dict(corners=np.flatnonzero(cut.corner))
+    for j in range(int(r.vertex_level.max()) + 1):
+        sel = np.flatnonzero(r.vertex_level == j)
+        L = hybridsub.limit_positions(V[cut.cut.origin], cut.faces, levels=j, scheme=scheme,
+                                      boundary="edge_and_corner", **corners)
         d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
         assert d.max(initial=0) <= 1e-9, (j, d.max())
 
@@ -438,9 +467,96 @@ def test_adaptive_arguments_refused_by_name(kwargs, match):
         hybridsub.refine_adaptive(TET, **kwargs)
 
 
-def test_sqrt3_with_a_boundary_is_refused():
-    with pytest.raises(ValueError, match="needs a closed mesh"):
-        hybridsub.refine_adaptive([[0, 1, 2], [0, 2, 3]], where=[0], levels=1, scheme="sqrt3")
+# ------------------------------------------------------------------------------------------
+# Kobbelt's √3 with a boundary: boundary edges kept on odd steps, trisected on even ones
+# ------------------------------------------------------------------------------------------
+
+def _shipped(name):
+    m = hybridsub.read_mesh(os.path.join(DATA, name + ".off"))
+    return m.vertices, m.faces
+
+
+def _dense_error(V, F, r, V2, surface):
+    """The largest distance between the output and the surface at 15 points of every face."""
+    charts = hybridsub._refiner.FaceCharts(F, len(V), lambda G, n: hybridsub._topology.build_level(G, n).twin)
+    for st_ in r.steps:
+        charts.step(st_)
+    g = np.linspace(0, 1, 5)
+    B = np.array([(a, b, 1 - a - b) for a in g for b in g if a + b <= 1 + 1e-12])
+    G = r.faces
+    f, b = charts.points(np.repeat(np.arange(len(G)), len(B)), np.tile(B, (len(G), 1)))
+    S = surface.evaluate(f, b).reshape(len(G), len(B), 3)
+    return float(np.linalg.norm(S - np.einsum("sj,fjc->fsc", B, V2[G]), axis=2).max())
+
+
+def _at_limit_positions(V, F, r, V2, scheme, tags, bound=1e-9):
+    """Every used output vertex at the limit position of the uniform vertex it is."""
+    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    used = np.isin(np.arange(r.n_vertices), r.faces)
+    for j in range(int(r.vertex_level.max(initial=0)) + 1):
+        sel = np.flatnonzero((r.vertex_level == j) & used)
+        if len(sel):
+            L = hybridsub.limit_positions(V, F, levels=j, scheme=scheme, **tags)
+            d = np.linalg.norm(V2[sel] - L[index[sel]], axis=1) / diagonal(V)
+            assert d.max() <= bound, (j, float(d.max()))
+
+
+@pytest.mark.parametrize("name, levels", [("mesh_with_border", 4), ("elephant-with-holes", 3)])
+def test_sqrt3_region_on_shipped_open_meshes(name, levels):
+    # A patch that reaches the boundary, refined through trisecting (even) steps: every vertex
+    # the uniform refinement's, the boundary loops kept, no T-vertex.
+    V, F = _shipped(name)
+    boundary_face = np.flatnonzero(np.isin(F, ms.boundary_edges(F)).sum(axis=1) >= 2)[0]
+    c = V[F].mean(axis=1)
+    where = np.argsort(np.linalg.norm(c - c[boundary_face], axis=1))[:len(F) // 6]
+    r = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme="sqrt3")
+    check_crack_free(V, F, r)
+    uniform_match(V, F, {}, "sqrt3", r, r.apply(V))
+    assert (r.face_level[np.isin(r.face_parent, where)] == levels).all()
+    assert r.face_level.min() == 0
+    assert len(r.faces) < 0.5 * len(hybridsub.refine(F, levels=levels, scheme="sqrt3").faces)
+
+
+@pytest.mark.parametrize("name, tol", [("mesh_with_border", "0.1%"), ("elephant-with-holes", "0.3%")])
+def test_sqrt3_tolerance_on_shipped_open_meshes(name, tol):
+    V, F = _shipped(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = hybridsub.refine_adaptive(F, V=V, tolerance=tol, scheme="sqrt3")
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance=tol, scheme="sqrt3")
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2  # a trisecting step was made
+    check_crack_free(V, F, r)
+    _at_limit_positions(V, F, r, V2, "sqrt3", {})
+    if name == "mesh_with_border":  # the tolerance on a denser sample than the criterion's
+        t = hybridsub._surface.adaptive.tolerance_of(tol, V)
+        assert _dense_error(V, F, r, V2, hybridsub.LimitSurface(V, F, scheme="sqrt3")) <= 1.5 * t
+
+
+@cfg(30)
+@given(mesh=ms.open_meshes(bowties=False), data=st.data())
+def test_sqrt3_region_on_open_meshes_is_crack_free_and_exact(mesh, data):
+    V, F = mesh
+    levels = data.draw(st.integers(1, 4 if len(F) <= 40 else 3))
+    where = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1))).random(len(F)) < data.draw(
+        st.sampled_from([0.1, 0.3, 0.6]))
+    r = hybridsub.refine_adaptive(F, where=where, levels=levels, scheme="sqrt3", n_vertices=len(V))
+    check_crack_free(V, F, r)
+    uniform_match(V, F, {}, "sqrt3", r, r.apply(V))
+    assert (r.face_level[where[r.face_parent]] == levels).all()
+
+
+def test_sqrt3_open_tolerance_with_options():
+    # boundary="edge_and_corner" (its corners pinned) and holes: exact, at the limit positions
+    # (non_manifold="cut": test_non_manifold_cut_is_exact).
+    I, J = np.meshgrid(np.arange(7), np.arange(7), indexing="ij")
+    V, F = ms.grid(6, 6, (I[:6, :6] + J[:6, :6]) % 2 == 0, z=np.sin(I) * np.cos(0.7 * J))
+    for tags in (dict(boundary="edge_and_corner"), dict(holes=[3, 17])):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = hybridsub.refine_adaptive(F, V=V, tolerance="0.5%", scheme="sqrt3", **tags)
+            V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.5%", scheme="sqrt3", **tags)
+        assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+        _at_limit_positions(V, F, r, V2, "sqrt3", tags)
 
 
 def test_inputs_are_not_written_to():
@@ -495,6 +611,19 @@ def test_cli_tolerance_takes_boundary(tmp_path, capsys):
     assert len(Fa) != len(F2) or not np.allclose(Va, V2)
 
 
+def test_cli_sqrt3_tolerance_on_an_open_mesh(tmp_path, capsys):
+    from hybridsub._app.cli import main
+    src = os.path.join(DATA, "mesh_with_border.off")
+    out = tmp_path / "a.obj"
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.1%", "--scheme", "sqrt3"]) == 0
+    assert "adaptive to" in capsys.readouterr().err
+    m = hybridsub.read_mesh(str(out))
+    given = hybridsub.read_mesh(src)
+    V2, F2 = hybridsub.subdivide_adaptive(given.vertices, given.faces, tolerance="0.1%", scheme="sqrt3")
+    assert np.array_equal(m.faces, F2) and np.allclose(m.vertices, V2, atol=1e-9)
+    assert len(ms.boundary_edges(F2)) > len(ms.boundary_edges(given.faces))  # the boundary was trisected
+
+
 def test_cli_info_reports_adaptive(capsys):
     from hybridsub._app.cli import main
     src = os.path.join(DATA, "icosahedron.off")
@@ -511,7 +640,9 @@ def test_cli_info_reports_adaptive(capsys):
 @given(mesh=ms.tagged_meshes(bowties=False), data=st.data())
 def test_tolerance_refinement_is_crack_free_and_exact(mesh, data):
     V, F, tags = mesh
-    scheme = data.draw(st.sampled_from(["hybrid", "loop"]))
+    scheme = data.draw(st.sampled_from(["hybrid", "loop", "sqrt3"]))
+    if scheme == "sqrt3":
+        tags = {}
     tol = data.draw(st.sampled_from(["2%", "5%"]))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", hybridsub.AdaptiveWarning)

@@ -97,6 +97,12 @@ def test_edge_and_corner_sqrt3_pins_the_lone_vertices():
     Y, _ = hybridsub.subdivide(V, F, levels=3, scheme="sqrt3")
     assert np.array_equal(X[lone], V[lone]) and not np.array_equal(Y[lone], V[lone])
     assert np.abs(X[len(V):] - Y[len(V):]).max() > 0  # the new points near them feel it
+    # Their limit positions: the pinned vertices themselves, and every vertex's limit that of a
+    # deep refinement (the oracle; 10 levels of √3 are within 1e-4 of the diagonal here).
+    P = hybridsub.limit_positions(V, F, scheme="sqrt3", boundary="edge_and_corner")
+    assert np.array_equal(P[lone], V[lone])
+    deep = hybridsub.refine(F, levels=10, scheme="sqrt3", boundary="edge_and_corner").apply(V)[:len(V)]
+    assert np.abs(deep - P).max() <= 1e-4 * np.linalg.norm(V.max(0) - V.min(0))
 
 
 @pytest.mark.parametrize("scheme", ["hybrid", "sqrt3", "loop"])

@@ -17,7 +17,9 @@ result is a vertex of the uniform refinement of its level, at its position. An e
 border (R on one side only) is neither split nor flipped: its edge point is not made, and
 the faces the step emitted with it are closed onto the edge's first end (a √3 face gives
 ``(c_f, u, w)``, a Loop face Loop's red–green closure). The faces on the other side are not
-touched, so the result has no T-vertex. Closure faces are never refined again.
+touched, so the result has no T-vertex. Closure faces are never refined again. Kobbelt's √3
+on a mesh with a boundary runs its step on R and the faces round it, whose boundary rule
+depends on the step's parity (:func:`_kobbelt_region`).
 
 >>> import numpy as np
 >>> from hybridsub._input import open_gate
@@ -40,6 +42,7 @@ import scipy.sparse as sp
 from .._input import RefineInput
 from .._topology import Level, build_level, child_level, plan_step
 from .refinement import Refinement, RefinementStep, _compose_cut
+from .._rules.step_rules import EDGE_TRISECT
 from .stencils import step_matrix
 
 
@@ -143,7 +146,8 @@ def _region_matrix(S: sp.csr_matrix, sub_ids, local, promoted, kept_new, n: int,
 
 
 def _sources(mesh: AdaptiveMesh, rf: np.ndarray, plan, n_new: int) -> np.ndarray:
-    """(n_new,) what made each point of a region's step (see ``RegionStep.source``; −1 for old vertices)."""
+    """(n_new,) what made each point of a step planned on the faces ``rf`` (see
+    ``RegionStep.source``; −1 for old vertices)."""
     m = len(mesh.faces)
     key = np.full(n_new, -1, np.int64)
     fp = plan.face_point.astype(np.int64)
@@ -154,35 +158,92 @@ def _sources(mesh: AdaptiveMesh, rf: np.ndarray, plan, n_new: int) -> np.ndarray
     g = 3 * rf[hh // 3] + hh % 3
     t = mesh.twin[g]
     key[ep[hh]] = m + np.where(t >= 0, np.minimum(g, t), g)
+    tri = hh[plan.hkind[hh] == EDGE_TRISECT]  # Kobbelt's trisection: the edge's second point too
+    key[ep[tri] + 1] = key[ep[tri]]
     return key
+
+
+def _kobbelt_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, loop_weights: str):
+    """Kobbelt's √3 with its boundary rule on the region ``region``: the step of level ``k``
+    (step k + 1, whose parity decides whether boundary edges are kept or trisected) run on R
+    and every face that shares a vertex with it (the *ghosts*), so that each vertex of R has
+    its whole star: R's border edges are interior edges there (a face of R beside one gets its
+    face point, the edge is not trisected), and a boundary edge of R is trisected with its
+    true boundary neighbours. Only R's children are kept; a border halfedge's flip triangle
+    ``(u, apex(g), apex(f))`` is closed onto the edge, ``(u, w, apex(f))``, as a √3 face beside
+    a face not refined (no ghost point is kept). Returns what :func:`refine_region` needs."""
+    F = mesh.faces
+    ring = grow(mesh, region, 1) & ~region
+    rf, gf = np.flatnonzero(region), np.flatnonzero(ring)
+    sub_faces = np.concatenate([rf, gf])
+    sub_ids = np.unique(F[sub_faces].ravel())
+    local = np.full(mesh.n_vertices, -1, np.int64)
+    local[sub_ids] = np.arange(len(sub_ids))
+    slot = np.full(len(F), -1, np.int64)
+    slot[sub_faces] = np.arange(len(sub_faces))
+    h = (3 * sub_faces[:, None] + np.arange(3)).ravel()
+    t = mesh.twin[h]
+    tf = np.where(t >= 0, slot[np.maximum(t, 0) // 3], -1)
+    ts = np.where(tf >= 0, 3 * tf + t % 3, -1)
+    level = Level(local[F[sub_faces]], len(sub_ids), ts, None, np.zeros(len(sub_faces), bool))
+    plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), "sqrt3", k + 1, loop_weights)
+    faces_c = child_level(level, plan, want_topology=False)[0]
+    S = step_matrix(level, plan).tocsr()
+    nr = len(rf)
+    # One child per halfedge (√3 splits no edge): halfedge h of R's faces made child h.
+    faces_c = faces_c[:3 * nr].copy()
+    hr = np.arange(3 * nr)
+    hb = hr[(t[hr] >= 0) & (tf[hr] >= nr)]  # R's border halfedges
+    faces_c[hb, 1] = level.faces[hb // 3, (hb % 3 + 1) % 3]
+    closure = np.zeros(len(faces_c), bool)
+    closure[hb] = True
+    # The new points kept: those R's children use (its face points and trisection points).
+    ns = len(sub_ids)
+    used = np.zeros(plan.n_new, bool)
+    used[faces_c.ravel()] = True
+    kept_new = np.flatnonzero(used[ns:]) + ns
+    return rf, sub_faces, sub_ids, local, plan, faces_c, 3 * np.arange(nr + 1), S, kept_new, closure
 
 
 def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
                   loop_weights: str) -> tuple[AdaptiveMesh, RegionStep]:
-    """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module)."""
+    """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module).
+    ``scheme="sqrt3"`` is Kobbelt's with his boundary rule (:func:`_kobbelt_region`); on a
+    closed mesh ``"hybrid"`` without tags is the same step, made on R alone."""
     F, n = mesh.faces, mesh.n_vertices
-    rf, sub_ids, local, level, border = _region_level(mesh, region)
-    ns, Fs = len(sub_ids), level.faces
-    plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), scheme, k + 1, loop_weights)
-    faces_c, child, offsets = child_level(level, plan)
-    S = step_matrix(level, plan).tocsr()
-    n_sub_new = plan.n_new
+    if scheme == "sqrt3":
+        rf, sub_faces, sub_ids, local, plan, faces_c, offsets, S, kept_new, closure = _kobbelt_region(
+            mesh, region, k, loop_weights)
+        to_mesh = np.full(plan.n_new, -1, np.int64)
+        to_mesh[:len(sub_ids)] = sub_ids
+        child_sharp = np.zeros(len(faces_c), bool)
+        child_hsharp = None
+    else:
+        rf, sub_ids, local, level, border = _region_level(mesh, region)
+        sub_faces = rf
+        ns, Fs = len(sub_ids), level.faces
+        plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), scheme, k + 1, loop_weights)
+        faces_c, child, offsets = child_level(level, plan)
+        S = step_matrix(level, plan).tocsr()
+        n_sub_new = plan.n_new
 
-    # The new points: kept (face points, edge points inside R or on the input's boundary) or
-    # dropped (edge points of border edges), each dropped one closed onto its edge's first end.
-    ep = plan.edge_point.astype(np.int64)
-    has = ep >= 0
-    dropped = np.zeros(n_sub_new, bool)
-    target = np.arange(n_sub_new, dtype=np.int64)
-    hb = np.flatnonzero(has & border)
-    dropped[ep[hb]] = True
-    target[ep[hb]] = Fs.ravel()[hb]  # the halfedge's origin (sub numbering)
-    kept_new = np.flatnonzero(~dropped[ns:]) + ns
-    source = _sources(mesh, rf, plan, n_sub_new)[kept_new]
-    to_mesh = np.empty(n_sub_new, np.int64)
-    to_mesh[:ns] = sub_ids
+        # The new points: kept (face points, edge points inside R or on the input's boundary) or
+        # dropped (edge points of border edges), each dropped one closed onto its edge's first end.
+        ep = plan.edge_point.astype(np.int64)
+        has = ep >= 0
+        dropped = np.zeros(n_sub_new, bool)
+        target = np.arange(n_sub_new, dtype=np.int64)
+        hb = np.flatnonzero(has & border)
+        dropped[ep[hb]] = True
+        target[ep[hb]] = Fs.ravel()[hb]  # the halfedge's origin (sub numbering)
+        kept_new = np.flatnonzero(~dropped[ns:]) + ns
+        to_mesh = np.empty(n_sub_new, np.int64)
+        to_mesh[:ns] = sub_ids
+        to_mesh[dropped] = sub_ids[target[dropped]]
+        closure = dropped[faces_c].any(axis=1)
+        child_sharp, child_hsharp = child.face_sharp, child.hsharp
+    source = _sources(mesh, sub_faces, plan, plan.n_new)[kept_new]
     to_mesh[kept_new] = n + np.arange(len(kept_new))
-    to_mesh[dropped] = sub_ids[target[dropped]]
     n1 = n + len(kept_new)
 
     # Promoted vertices: every face around them in R.
@@ -196,7 +257,6 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     # rest kept, in the order of the faces they come from.
     kids = to_mesh[faces_c]
     ok = (kids[:, 0] != kids[:, 1]) & (kids[:, 1] != kids[:, 2]) & (kids[:, 2] != kids[:, 0])
-    closure = dropped[faces_c].any(axis=1)
     kid_parent = rf[np.repeat(np.arange(len(rf)), np.diff(offsets))]
     keep_f = np.flatnonzero(~region)
     emitter = np.concatenate([keep_f, kid_parent[ok]])
@@ -207,14 +267,14 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     def merged(old, new):
         return np.concatenate([old[keep_f], new[ok]])[order]
 
-    face_sharp = merged(mesh.face_sharp, child.face_sharp)
+    face_sharp = merged(mesh.face_sharp, child_sharp)
     face_level = merged(mesh.face_level, np.full(len(kids), k + 1, np.int64))
     genuine = merged(mesh.genuine, ~closure)
     face_parent = mesh.face_parent[emitter]
     hsharp = None
     if mesh.hsharp is not None:
         old_h = mesh.hsharp.reshape(-1, 3)
-        new_h = child.hsharp.reshape(-1, 3) if child.hsharp is not None else np.zeros((len(kids), 3))
+        new_h = child_hsharp.reshape(-1, 3) if child_hsharp is not None else np.zeros((len(kids), 3))
         hsharp = merged(old_h, new_h).ravel()
     vertex_level = np.concatenate([mesh.vertex_level, np.full(n1 - n, k + 1, np.int64)])
     vertex_level[prom] = k + 1
@@ -289,7 +349,9 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
     ``max_levels``; the wanted levels are graded (:data:`RINGS`) and inherited by the
     children, and ``on_level`` may raise them level by level."""
     mesh = start(inp)
-    scheme = "hybrid" if inp.scheme == "sqrt3" else inp.scheme
+    scheme = inp.scheme
+    if scheme == "sqrt3" and not (inp.level.twin < 0).any():  # closed: the hybrid's step without tags, on R alone
+        scheme = "hybrid"
     rings = RINGS[inp.scheme]
     want = np.minimum(np.asarray(want0, np.int64), max_levels)
     steps, st = [], None

@@ -84,13 +84,6 @@ def _max_levels(max_levels) -> int:
     return int(max_levels)
 
 
-def _closed_for_sqrt3(inp: RefineInput) -> None:
-    if inp.scheme == "sqrt3" and inp.n_faces and (inp.level.twin < 0).any():
-        raise ValueError('adaptive refinement with scheme="sqrt3" needs a closed mesh (Kobbelt\'s boundary rule '
-                         'trisects boundary edges every other level, which a region cannot); use scheme="hybrid", '
-                         'whose boundary is a crease')
-
-
 def spread_one_ring(mesh: AdaptiveMesh, want: np.ndarray) -> np.ndarray:
     """Each face's wanted level raised to the largest wanted level of the faces that share a
     vertex with it."""
@@ -143,7 +136,7 @@ class Criterion:
             self.error[fresh[hidden]] = 0.0
             self.done[fresh[hidden]] = True
             fresh = fresh[~hidden]
-        self._mask_pass(mesh, active)
+        self._mask_pass(mesh, active, k)
         self.error[fresh] = self._errors(mesh, fresh)
         self.done[fresh] = True
         want = np.zeros(len(mesh.faces), np.int64)
@@ -201,8 +194,21 @@ class Criterion:
         L = plan.limit_csr(len(ids), only=local[v])
         return v, (L @ P[ids])[local[v]]
 
-    def _mask_pass(self, mesh: AdaptiveMesh, active: np.ndarray) -> None:
-        v, q = self._masked_limits(mesh, active, self.P, ~self.known)
+    def _mask_pass(self, mesh: AdaptiveMesh, active: np.ndarray, k: int) -> None:
+        todo = ~self.known
+        if self.inp.scheme == "sqrt3" and k % 2:
+            # Kobbelt's next step trisects the boundary: an inner vertex of a face with a boundary
+            # edge gets no face point there, and its one-ring's stationary mask (that of the
+            # levels whose next step keeps the boundary) is not its limit; the surface places it.
+            # (Boundary vertices are fine: an odd step leaves the boundary polygon as it was.)
+            F = mesh.faces
+            by_edge = (mesh.twin.reshape(-1, 3) < 0).any(axis=1)
+            near = np.zeros(mesh.n_vertices, bool)
+            near[F[by_edge].ravel()] = True
+            on = np.zeros(mesh.n_vertices, bool)
+            on[F.ravel()[mesh.twin < 0]] = True
+            todo &= ~(near & ~on)
+        v, q = self._masked_limits(mesh, active, self.P, todo)
         self.Q[v] = q
         self.known[v] = True
 
@@ -278,7 +284,7 @@ def _by_tolerance(inp: RefineInput, X: np.ndarray, tolerance, max_levels: int, l
         u = inp.uncut
         surface = LimitSurface(X, u.faces, u.sharp_edges, scheme=inp.scheme, sharpness=u.sharpness,
                                sharp_faces=sharp_faces, corners=np.flatnonzero(u.corner),
-                               loop_weights=inp.loop_weights, non_manifold="cut")
+                               loop_weights=inp.loop_weights, non_manifold="cut", boundary=_surface_boundary(inp))
         X = X[inp.cut.origin]
     holder = {}
 
@@ -342,13 +348,20 @@ def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, co
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
                     corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold)
-    _closed_for_sqrt3(inp)
     return inp
+
+
+def _surface_boundary(inp: RefineInput) -> str:
+    """The boundary interpolation the criterion's surface is built with where it finds the
+    corners ``boundary="edge_and_corner"`` adds itself (``"none"`` refines as ``"edge_only"``)."""
+    return "edge_and_corner" if inp.boundary == "edge_and_corner" else "edge_only"
 
 
 def _corner_tags(inp: RefineInput) -> dict:
     """The gate's corners as ``LimitSurface`` takes them: indices, and their sharpness beside
-    them where some are semi-sharp."""
+    them where some are semi-sharp (``"sqrt3"``: its boundary interpolation)."""
+    if inp.scheme == "sqrt3":  # no corners of its own: those of boundary="edge_and_corner" come from it again
+        return dict(boundary=_surface_boundary(inp))
     if inp.corner_sharpness is None:
         return dict(corners=np.flatnonzero(inp.corner))
     c = np.flatnonzero(inp.corner_sharpness > 0)
@@ -378,7 +391,8 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
     Parameters
     ----------
     F, sharp_edges, scheme, sharpness, sharp_faces, corners, loop_weights, n_vertices
-        As for :func:`hybridsub.refine` (checked the same way). ``"sqrt3"`` needs a closed mesh.
+        As for :func:`hybridsub.refine` (checked the same way); ``"sqrt3"`` with a boundary
+        follows Kobbelt's boundary rule at each face's own level.
     corner_sharpness, boundary, holes, non_manifold
         As for :func:`hybridsub.refine`: semi-sharp corners (with a tolerance, not together
         with ``"cut"``), OpenSubdiv's boundary interpolation, faces left

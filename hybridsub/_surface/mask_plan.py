@@ -154,9 +154,9 @@ def _classify(level, sec, esharp, face_sharp, corner, scheme, loop_weights) -> _
     unused = valence == 0
     if scheme == "sqrt3":
         nb = np.bincount(ev, weights=np.repeat(level.boundary_edge, 2), minlength=n).astype(np.int64)
-        is_corner = unused | (nb > 2)
-        is_crease = nb == 2
-        smooth = (nb == 0) & ~unused
+        is_corner = unused | corner | (nb > 2)  # corner: boundary="edge_and_corner"'s lone boundary vertices
+        is_crease = (nb == 2) & ~is_corner
+        smooth = (nb == 0) & ~is_corner
         smooth_w = np.where(smooth, LR.smooth_limit_weight(valence, R.REGION_SQRT3), 0.0)
         pos_ok = np.ones(n, dtype=bool)
         dart_v = np.zeros(n, dtype=bool)
