@@ -7,6 +7,7 @@ import scipy.sparse as sp
 from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
 
 import hybridsub
+from hybridsub._surface import cache as C
 from hybridsub._surface import descent as D
 from hybridsub._surface.regular import is_regular, regular_torus
 
@@ -164,6 +165,33 @@ def test_transitions_are_stored_once_per_content(name, shared):
     n_cands = int(live.sum())
     assert len(stored) < shared * n_cands  # candidates share their rows (most of them on the hybrid)
     assert len(t.t_val.a) < shared * len(plain._table.t_val.a)
+
+
+@pytest.mark.parametrize("name", ["hybrid-crease", "hybrid-boundary"])  # Loop's and √3's keys repeat outright here
+def test_keys_from_recipes_give_the_bits_of_refining_them(name, monkeypatch):
+    """Keys of a class met before take its recipes instead of being refined (candidate maps,
+    child patches, transitions): the surface and its rows are those of a table that keeps no
+    recipe, to the bit, and recipes were used."""
+    V, F, kw = CASES[name]
+    face, bary = _points(F, 300, seed=12)
+    with monkeypatch.context() as m:
+        m.setattr(C, "LEARN", 1 << 40)  # no class ever has that many keys: every key refined
+        plain = hybridsub.LimitSurface(V, F, depth=10, **kw)
+        ref = plain.evaluate(face, bary, derivatives=True)
+        ref_rows = plain.evaluation_matrix(face[:50], bary[:50], derivatives=True)
+    assert not (plain._table.cls_cand.a >= 0).any()
+    used = []
+    clone = C.PatchTable._clone_children
+    monkeypatch.setattr(C.PatchTable, "_clone_children", lambda self, c, *a: used.append(len(c)) or clone(self, c, *a))
+    s = hybridsub.LimitSurface(V, F, depth=10, **kw)
+    got = s.evaluate(face, bary, derivatives=True)
+    rows = s.evaluation_matrix(face[:50], bary[:50], derivatives=True)
+    assert sum(used) > 0 and (s._table.cls_cand.a >= 0).any()
+    for a, b in zip(got, ref):
+        assert np.array_equal(a, b)
+    for a, b in zip(rows, ref_rows):
+        assert (a != b).nnz == 0
+    assert s._table.n_keys == plain._table.n_keys
 
 
 def _torus(n=6, seed=6):
@@ -339,3 +367,51 @@ def test_threaded_walk_gives_the_serial_bits(mesh, monkeypatch):
         got[threaded] = hybridsub.LimitSurface(V, F, **kw).evaluate(face, bary, derivatives=True)
     for a, b in zip(got[False], got[True]):
         assert np.array_equal(a, b)
+
+
+def test_small_index_arrays_widen_when_a_piece_needs_more():
+    """The representatives' corners and twins are kept as int16 until a piece has more than
+    32767 of them: then the whole array is widened, its earlier entries unchanged."""
+    from hybridsub._surface.cache import Grow
+
+    g = Grow((3,), np.int16)
+    g.append([[1, 2, 3], [-1, 4, 32767]])
+    assert g.a.dtype == np.int16
+    g.append([[5, 40000, -1]])
+    assert g.a.dtype == np.int32
+    assert g.a.tolist() == [[1, 2, 3], [-1, 4, 32767], [5, 40000, -1]]
+    g.append(np.zeros((30, 3), np.int64))
+    assert g.a.dtype == np.int32 and g.n == 33
+
+
+def test_chunks_keep_the_cache_near_its_cap_within_a_call(monkeypatch):
+    """Points whose keys rarely repeat (the hybrid beside creases) go in chunks sized by the
+    cache's growth per point, so one call holds the cache near ``CACHE_BYTES`` (it was one chunk
+    of up to 20000 points, 630 MB on a small CAD part)."""
+    import hybridsub._surface.surface as surface
+
+    V, F = OCTA_V, OCTA_F
+    kw = dict(sharp_edges=[[0, 2], [2, 1], [1, 3], [3, 0]])  # the equator
+    face, bary = _points(F, 2000, seed=5)
+    whole = hybridsub.LimitSurface(V, F, **kw).evaluate(face, bary, derivatives=True)
+    cap = 2**24
+    monkeypatch.setattr(surface, "CACHE_BYTES", cap)
+    monkeypatch.setattr(surface, "FIRST_CHUNK", 200)
+    s = hybridsub.LimitSurface(V, F, **kw)
+    peaks = []
+    emptied = s._new_cache
+
+    def watched():
+        peaks.append(s._table.nbytes)
+        emptied()
+
+    s._new_cache = watched
+    got = s.evaluate(face, bary, derivatives=True)
+    peaks.append(s._table.nbytes)
+    assert len(peaks) > 2 and s._chunk < surface.CHUNK  # emptied on the way, in smaller chunks
+    assert max(peaks) < 2 * cap, [p / cap for p in peaks]
+    # A key's representative is the first patch met with it, so another history of the cache
+    # may take another one (its shapes within the key's rounding): the same surface to rounding.
+    # Values to rounding; derivatives to their last interpolation's error (1e-8 relative).
+    for a, b, tol in zip(whole, got, (1e-13, 1e-8, 1e-8)):
+        assert np.abs(a - b).max() <= tol * np.abs(a).max()

@@ -301,11 +301,30 @@ def test_the_depth_rule_skips_only_points_it_would_leave_at_the_default(name):
     s = hybridsub.LimitSurface(V, F, **kw)
     face, bary = _near_features(s, 3000, seed=11)
     unfiltered = copy.copy(s._depths)
-    unfiltered.reach_vertex = unfiltered.reach_edge = np.inf
+    unfiltered._reach = lambda base: (np.inf, np.inf)
     for depth in (s.depth - 6, s.depth, s.depth + 6):
-        d = s._depths(face, bary, depth)
-        assert np.array_equal(d, unfiltered(face, bary, depth)) and (d >= depth).all()
-        assert (d > depth).any()
+        for rule_depth in (None, s.depth):
+            d = s._depths(face, bary, depth, rule_depth)
+            assert np.array_equal(d, unfiltered(face, bary, depth, rule_depth)) and (d >= depth).all()
+            assert (d > depth).any()
+
+
+@pytest.mark.parametrize("name", ["hybrid-creases", "sqrt3", "loop-creases"])
+def test_a_shallow_evaluation_keeps_the_depth_rule_next_to_features(name):
+    """``project``'s first iterations evaluate at depth 8, relying on an error below their
+    margin (1e-5 diagonals): with ``rule_depth`` a point the rule takes deeper than the shallow
+    depth keeps the rule's own depth, so points next to irregular vertices and split edges are
+    as close to the surface as elsewhere (the whole rule shifted down leaves them 1e-7 off here,
+    and a point 3e-3 of a face from an octahedron's corner 3e-4 diagonals off, where project
+    then missed its foot)."""
+    V, F, kw = _feature_cases()[name]
+    s = hybridsub.LimitSurface(V, F, **kw)
+    face, bary = _near_features(s, 300, seed=5)
+    exact = s.evaluate(face, bary)
+    X = np.ascontiguousarray(s.vertices)
+    err = np.linalg.norm(s._applied(face, bary, 1, 8, X, rule_depth=s.depth)[0] - exact, axis=1) / _diag(V)
+    shifted = np.linalg.norm(s._applied(face, bary, 1, 8, X)[0] - exact, axis=1) / _diag(V)
+    assert err.max() < 1e-10 and shifted.max() > 1e-8, (err.max(), shifted.max())
 
 
 @pytest.mark.parametrize("name", ["sqrt3", "hybrid-creases"])

@@ -91,22 +91,39 @@ def face_records(F, twin, hbits, face_sharp, shape, fperm, frank, vrank, entry, 
             out[r, 3 + c] = 3 * (frank[t // 3] - base) + (t % 3 - entry[t // 3] + 3) % 3 if t >= 0 else -1
             out[r, 7 + c] = hbits[3 * f + cc]
         out[r, 6] = 1 if face_sharp[f] else 0
-        s1, s2 = (s0 + 1) % 3, (s0 + 2) % 3
-        ax, ay = shape[f, s0, 0], shape[f, s0, 1]
-        ex, ey = shape[f, s1, 0] - ax, shape[f, s1, 1] - ay
-        ln = math.sqrt(ex * ex + ey * ey)
-        co, si = ex / ln, ey / ln
-        dx, dy = shape[f, s2, 0] - ax, shape[f, s2, 1] - ay
-        s = scale[i]
-        norm[r, 0, 0] = 0.0
-        norm[r, 0, 1] = 0.0
-        norm[r, 1, 0] = ln / s
-        norm[r, 1, 1] = 0.0
-        norm[r, 2, 0] = (co * dx + si * dy) / s
-        norm[r, 2, 1] = (co * dy - si * dx) / s
-        out[r, 10] = round(norm[r, 1, 0] / grid)
-        out[r, 11] = round(norm[r, 2, 0] / grid)
-        out[r, 12] = round(norm[r, 2, 1] / grid)
+        _normalise(shape, f, s0, scale[i], grid, r, out, norm)
+
+
+@kernel(inline="always")
+def _normalise(shape, f, s0, s, grid, r, out, norm):
+    """Face ``f``'s corners from corner ``s0`` moved by a rigid motion (corner 0 at the origin,
+    corner 1 on +x) and scaled by ``1 / s``: ``norm[r]``, and rounded to ``grid`` in
+    ``out[r, 10:13]``."""
+    s1, s2 = (s0 + 1) % 3, (s0 + 2) % 3
+    ax, ay = shape[f, s0, 0], shape[f, s0, 1]
+    ex, ey = shape[f, s1, 0] - ax, shape[f, s1, 1] - ay
+    ln = math.sqrt(ex * ex + ey * ey)
+    co, si = ex / ln, ey / ln
+    dx, dy = shape[f, s2, 0] - ax, shape[f, s2, 1] - ay
+    norm[r, 0, 0] = 0.0
+    norm[r, 0, 1] = 0.0
+    norm[r, 1, 0] = ln / s
+    norm[r, 1, 1] = 0.0
+    norm[r, 2, 0] = (co * dx + si * dy) / s
+    norm[r, 2, 1] = (co * dy - si * dx) / s
+    out[r, 10] = round(norm[r, 1, 0] / grid)
+    out[r, 11] = round(norm[r, 2, 0] / grid)
+    out[r, 12] = round(norm[r, 2, 1] / grid)
+
+
+@kernel
+def shape_records(shape, fstart, scale, grid, out, norm):
+    """:func:`face_records`' shape part for faces already in canonical order, their corners
+    from the one they were entered at: ``out[:, 10:13]`` and ``norm`` of piece ``i``'s faces
+    ``fstart[i]:fstart[i + 1]``, scaled by ``1 / scale[i]``."""
+    for i in range(len(fstart) - 1):
+        for r in range(fstart[i], fstart[i + 1]):
+            _normalise(shape, r, 0, scale[i], grid, r, out, norm)
 
 
 @kernel(inline="always")
@@ -118,29 +135,79 @@ def _mix(z):
     return z ^ (z >> np.uint64(31))
 
 
+@kernel(inline="always")
+def _round(acc, w, p, q, r):
+    """One word into one lane: multiply, rotate, multiply (xxHash's round)."""
+    acc = acc + w * p
+    acc = (acc << r) | (acc >> (np.uint64(64) - r))
+    return acc * q
+
+
+@kernel(inline="always")
+def _lanes(a, p, q, r, w0, w1, w2, w3):
+    a[0] = _round(a[0], w0, p, q, r)
+    a[1] = _round(a[1], w1, p, q, r)
+    a[2] = _round(a[2], w2, p, q, r)
+    a[3] = _round(a[3], w3, p, q, r)
+
+
+@kernel(inline="always")
+def _merge(a, n):
+    """The four lanes and the sizes ``n`` through the finaliser: every bit moves every bit."""
+    h = _mix(a[0])
+    h = _mix(h ^ a[1])
+    h = _mix(h ^ a[2])
+    h = _mix(h ^ a[3])
+    return _mix(h ^ n)
+
+
 @kernel
 def key_hashes(rec, fstart, cv, vstart, parity, out):
-    """A 128-bit hash of every piece's key (two independently seeded chains over its face
-    records, its vertices' corner flags, its sizes and the step parity): ``out`` (k, 2)."""
+    """A 128-bit hash of every piece's key (two independently seeded hashes, each of four
+    lanes, over its face records, its vertices' corner flags, its sizes and the step
+    parity): ``out`` (k, 2)."""
+    p1, q1, r1 = np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x9E3779B185EBCA87), np.uint64(31)
+    p2, q2, r2 = np.uint64(0xA4093822299F31D1), np.uint64(0x165667B19E3779F9), np.uint64(27)
+    a = np.empty(4, np.uint64)
+    b = np.empty(4, np.uint64)
+    ncol = rec.shape[1]
     for i in range(len(fstart) - 1):
-        h1 = _mix(np.uint64(parity) ^ np.uint64(0x243F6A8885A308D3))
-        h2 = _mix(np.uint64(parity) ^ np.uint64(0x13198A2E03707344))
+        for j in range(4):
+            a[j] = _mix(np.uint64(parity) ^ np.uint64(0x243F6A8885A308D3 + j))
+            b[j] = _mix(np.uint64(parity) ^ np.uint64(0x13198A2E03707344 + j))
         for r in range(fstart[i], fstart[i + 1]):
-            for c in range(rec.shape[1]):
+            c = 0
+            while c + 4 <= ncol:
+                w0, w1 = np.uint64(rec[r, c]), np.uint64(rec[r, c + 1])
+                w2, w3 = np.uint64(rec[r, c + 2]), np.uint64(rec[r, c + 3])
+                _lanes(a, p1, q1, r1, w0, w1, w2, w3)
+                _lanes(b, p2, q2, r2, w0, w1, w2, w3)
+                c += 4
+            while c < ncol:
                 w = np.uint64(rec[r, c])
-                h1 = _mix(h1 ^ w)
-                h2 = _mix(h2 + w * np.uint64(0xA4093822299F31D1))
-        for v in range(vstart[i], vstart[i + 1]):
+                a[0] = _round(a[0], w, p1, q1, r1)
+                b[0] = _round(b[0], w, p2, q2, r2)
+                c += 1
+        v = vstart[i]
+        while v + 4 <= vstart[i + 1]:
+            w0, w1, w2, w3 = np.uint64(cv[v]), np.uint64(cv[v + 1]), np.uint64(cv[v + 2]), np.uint64(cv[v + 3])
+            _lanes(a, p1, q1, r1, w0, w1, w2, w3)
+            _lanes(b, p2, q2, r2, w0, w1, w2, w3)
+            v += 4
+        while v < vstart[i + 1]:
             w = np.uint64(cv[v])
-            h1 = _mix(h1 ^ w)
-            h2 = _mix(h2 + w * np.uint64(0xA4093822299F31D1))
+            a[1] = _round(a[1], w, p1, q1, r1)
+            b[1] = _round(b[1], w, p2, q2, r2)
+            v += 1
         n = np.uint64(fstart[i + 1] - fstart[i]) << np.uint64(32) | np.uint64(vstart[i + 1] - vstart[i])
-        out[i, 0] = _mix(h1 ^ n)
-        out[i, 1] = _mix(h2 + n)
+        out[i, 0] = _merge(a, n)
+        out[i, 1] = _merge(b, n)
 
 
 #: The bits of an infinite sharpness (``face_records`` keeps sharpness as its float's bits).
 INF_BITS = np.array([np.inf]).view(np.int64)[0]
+#: The bits of −0.0 (a sharpness equal to 0).
+MINUS_ZERO_BITS = np.array([-0.0]).view(np.int64)[0]
 
 
 @kernel(inline="always")
@@ -230,3 +297,166 @@ def regular_flags(rec, fstart, cv, vstart, out):
             h = first if last == first + 1 else last
             ok = _crease(rec, a, h)
         out[i] = 1 if ok else 0
+
+
+@kernel
+def transition_hashes(row, col, vbits, bounds, out):
+    """A 128-bit hash of every transition's contents (entries ``bounds[i]:bounds[i + 1]`` of
+    ``row``, ``col`` and ``vbits``, the weights' bits; as :func:`key_hashes`): ``out`` (k, 2)."""
+    p1, q1, r1 = np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x9E3779B185EBCA87), np.uint64(31)
+    p2, q2, r2 = np.uint64(0xA4093822299F31D1), np.uint64(0x165667B19E3779F9), np.uint64(27)
+    a = np.empty(4, np.uint64)
+    b = np.empty(4, np.uint64)
+    low = np.uint64(0xFFFFFFFF)
+    for i in range(len(bounds) - 1):
+        for j in range(4):
+            a[j] = _mix(np.uint64(0x452821E638D01377 + j))
+            b[j] = _mix(np.uint64(0xBE5466CF34E90C6C + j))
+        e = bounds[i]
+        while e + 2 <= bounds[i + 1]:
+            w0 = (np.uint64(row[e]) << np.uint64(32)) | (np.uint64(col[e]) & low)
+            w2 = (np.uint64(row[e + 1]) << np.uint64(32)) | (np.uint64(col[e + 1]) & low)
+            w1, w3 = np.uint64(vbits[e]), np.uint64(vbits[e + 1])
+            _lanes(a, p1, q1, r1, w0, w1, w2, w3)
+            _lanes(b, p2, q2, r2, w0, w1, w2, w3)
+            e += 2
+        if e < bounds[i + 1]:
+            w0 = (np.uint64(row[e]) << np.uint64(32)) | (np.uint64(col[e]) & low)
+            w1 = np.uint64(vbits[e])
+            a[0] = _round(a[0], w0, p1, q1, r1)
+            a[1] = _round(a[1], w1, p1, q1, r1)
+            b[0] = _round(b[0], w0, p2, q2, r2)
+            b[1] = _round(b[1], w1, p2, q2, r2)
+        n = np.uint64(bounds[i + 1] - bounds[i])
+        out[i, 0] = _merge(a, n)
+        out[i, 1] = _merge(b, n)
+
+
+@kernel
+def support_codes(verts, off, ids, w, table, sup, code):
+    """The chart supports ``ids``, ``w`` (n', 3) of the vertices ``verts`` over their piece's
+    own vertices (``off``: the piece's first): ``sup`` (k, 3) (−1: unused) and ``code``
+    (k, 3) the weights' places in ``table``. Returns False if a weight is not there."""
+    for i in range(len(verts)):
+        v = verts[i]
+        for s in range(3):
+            x = ids[v, s]
+            sup[i, s] = x - off[i] if x >= 0 else -1
+            c = -1
+            for j in range(len(table)):
+                if w[v, s] == table[j]:
+                    c = j
+                    break
+            if c < 0:
+                return False
+            code[i, s] = c
+    return True
+
+
+@kernel
+def gather_pieces(keys, f0, nf, rep_f, rep_twin, rep_shape, foff, voff, faces, twin, shape):
+    """The representatives of ``keys`` (faces ``f0[k]:f0[k] + nf[k]`` of the stored corners
+    ``rep_f``, twins ``rep_twin`` and shapes ``rep_shape``, see :class:`.cache.PatchTable`)
+    as one mesh of disjoint pieces, piece ``i`` from face ``foff[i]`` and vertex ``voff[i]``:
+    fills ``faces`` (m, 3), ``twin`` (3m) and ``shape`` (m, 3, 2)."""
+    for i in range(len(keys)):
+        a, fo, vo = f0[keys[i]], foff[i], voff[i]
+        for r in range(nf[keys[i]]):
+            g = fo + r
+            for c in range(3):
+                faces[g, c] = rep_f[a + r, c] + vo
+                t = rep_twin[a + r, c]
+                twin[3 * g + c] = t + 3 * fo if t >= 0 else -1
+            shape[g, 0, 0] = 0.0
+            shape[g, 0, 1] = 0.0
+            shape[g, 1, 0] = rep_shape[a + r, 0]
+            shape[g, 1, 1] = 0.0
+            shape[g, 2, 0] = rep_shape[a + r, 1]
+            shape[g, 2, 1] = rep_shape[a + r, 2]
+
+
+@kernel
+def representative_rows(new, rec, fstart, norm, fs, cv, vstart, faces, twin, sharp_face, shape, hbits, crec, corner,
+                        sharp):
+    """The rows the pieces ``new`` keep as representatives, one after another: from their
+    face records ``rec`` (:func:`face_records`), corners ``faces`` (m, 3), ``twin`` (m, 3),
+    halfedge sharpness bits ``hbits`` (m, 3), the connectivity and tags ``crec`` (m, 10)
+    (the records without their shapes), sharp faces ``sharp_face`` from ``fs``, shapes
+    ``shape`` (m, 3: corner 1's x, corner 2's x and y) from ``norm``; corner tags ``corner``
+    from ``cv``; ``sharp`` (k,) whether a piece has a tagged halfedge."""
+    g = 0
+    u = 0
+    for i in range(len(new)):
+        p = new[i]
+        any_sharp = False
+        for r in range(fstart[p], fstart[p + 1]):
+            for c in range(3):
+                faces[g, c] = rec[r, c]
+                twin[g, c] = rec[r, 3 + c]
+                hbits[g, c] = rec[r, 7 + c]
+                if rec[r, 7 + c] != 0 and rec[r, 7 + c] != MINUS_ZERO_BITS:
+                    any_sharp = True
+            for c in range(10):
+                crec[g, c] = rec[r, c]
+            sharp_face[g] = fs[r]
+            shape[g, 0] = norm[r, 1, 0]
+            shape[g, 1] = norm[r, 2, 0]
+            shape[g, 2] = norm[r, 2, 1]
+            g += 1
+        sharp[i] = any_sharp
+        for v in range(vstart[p], vstart[p + 1]):
+            corner[u] = cv[v]
+            u += 1
+
+
+@kernel
+def clone_rows(ck, at, f0, v0, foff, voff, cf_parent, cv_sup, cv_w, weights, rep_f0, rep_nf, rep_v0, nv, rep_f,
+               rep_twin, rep_fs, rep_h0, rep_hbits, rep_corner, corners, parent, sup, w, rec, fs, cv):
+    """The inputs of ``child_shapes`` and the records of child patches made from recipes
+    (:meth:`.cache.PatchTable._clone_children`): piece ``i`` is the recipe's child key
+    ``ck[i]`` (its faces' parents from ``f0[i]`` in ``cf_parent``, its vertices' supports
+    from ``v0[i]`` in ``cv_sup``, ``cv_w``) over the owner's piece ``at[i]`` (faces from
+    ``foff``, vertices from ``voff``). Fills ``corners`` (m, 3) rows of ``sup``, ``w``
+    (n, 3), ``parent`` (m,), and the key's ``rec`` (m, 13: all but the shapes), sharp faces
+    ``fs`` and corner tags ``cv``."""
+    g = 0
+    u = 0
+    for i in range(len(ck)):
+        k = ck[i]
+        fo, vo = foff[at[i]], voff[at[i]]
+        a, h0 = rep_f0[k], rep_h0[k]
+        for r in range(rep_nf[k]):
+            for c in range(3):
+                x = rep_f[a + r, c]
+                corners[g, c] = x + u
+                rec[g, c] = x
+                rec[g, 3 + c] = rep_twin[a + r, c]
+                rec[g, 7 + c] = rep_hbits[h0 + r, c] if h0 >= 0 else 0
+            rec[g, 6] = 1 if rep_fs[a + r] else 0
+            fs[g] = rep_fs[a + r]
+            parent[g] = cf_parent[f0[i] + r] + fo
+            g += 1
+        b = rep_v0[k]
+        for j in range(nv[k]):
+            for s in range(3):
+                x = cv_sup[v0[i] + j, s]
+                sup[u, s] = x + vo if x >= 0 else -1
+                w[u, s] = weights[cv_w[v0[i] + j, s]]
+            cv[u] = rep_corner[b + j]
+            u += 1
+
+
+@kernel
+def candidate_rows(kk, at, foff, voff, ct_parent, ct_sup, ct_w, weights, parent, sup, w):
+    """The inputs of ``child_shapes`` for candidates made from their class's recipe
+    (:meth:`.cache.PatchTable._clone_steps`): candidate ``i`` is recipe row ``at[i]`` over
+    piece ``kk[i]`` (faces from ``foff``, vertices from ``voff``). Fills ``parent`` (q,),
+    ``sup``, ``w`` (3q, 3): the supports of its corners, one row each."""
+    for i in range(len(at)):
+        fo, vo = foff[kk[i]], voff[kk[i]]
+        parent[i] = ct_parent[at[i]] + fo
+        for c in range(3):
+            for s in range(3):
+                x = ct_sup[at[i], c, s]
+                sup[3 * i + c, s] = x + vo if x >= 0 else -1
+                w[3 * i + c, s] = weights[ct_w[at[i], c, s]]

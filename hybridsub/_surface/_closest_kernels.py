@@ -76,8 +76,9 @@ def closest_among(points, P, faces, candidates, face_out, bary_out, d2_out):
 
 
 @kernel
-def bin_faces(P, faces, lo, h, dims, start):
-    """Cell lists of a uniform grid: every face in each cell its bounding box touches.
+def bin_faces(P, faces, grow, lo, h, dims, start):
+    """Cell lists of a uniform grid: every face in each cell its bounding box, grown by
+    ``grow[f]`` on every side, touches.
 
     ``lo`` (3,) the grid's corner, ``h`` the cell size, ``dims`` (3,) cells per axis;
     ``start`` (nx·ny·nz + 1,) zeroed by the caller, filled with each cell's offset. Returns
@@ -87,8 +88,8 @@ def bin_faces(P, faces, lo, h, dims, start):
     box = np.empty((nf, 6), np.int64)
     for f in range(nf):
         for a in range(3):
-            x0 = min(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a])
-            x1 = max(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a])
+            x0 = min(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a]) - grow[f]
+            x1 = max(P[faces[f, 0], a], P[faces[f, 1], a], P[faces[f, 2], a]) + grow[f]
             box[f, a] = min(max(int((x0 - lo[a]) / h), 0), dims[a] - 1)
             box[f, 3 + a] = min(max(int((x1 - lo[a]) / h), 0), dims[a] - 1)
     for f in range(nf):
@@ -267,7 +268,7 @@ def ring_deviation(P, faces, ring_start, ring, out):
 
 
 @kernel(parallel=True)
-def faces_within(points, P, faces, eps, eps_max, ring_start, ring, lo, h, dims, start, cell_faces, bound, out_face,
+def faces_within(points, P, faces, eps, ring_start, ring, lo, h, dims, start, cell_faces, bound, out_face,
                  out_bary, out_d, out_lb, count):
     """For each point i, the faces f whose lower bound on the distance to the limit surface over
     them is below ``bound[i]``.
@@ -275,9 +276,11 @@ def faces_within(points, P, faces, eps, eps_max, ring_start, ring, lo, h, dims, 
     The limit surface over f lies in the convex hull of its ring's vertices, so no nearer to
     p than ``d − eps[f]`` (d = dist(p, f)) nor than ``d − max_v n·(v − c)`` (c the closest
     point of f, n = (p − c) / d: the plane through c normal to n, pushed out to the ring, has
-    the hull on one side). The grid of :func:`bin_faces` is visited in shells as
-    :func:`closest_in_grid` does, until no face of the next shell can be nearer than
-    ``bound[i] + eps_max``. Keeps the ``out_face.shape[1]`` nearest such faces (by distance),
+    the hull on one side). The grid is :func:`bin_faces`' with every face's box grown by its
+    ``eps[f]``, over the grown boxes: the hull lies in the grown box, so a face none of whose
+    cells is nearer p than ``bound[i]`` cannot qualify. Its cells are visited in shells as
+    :func:`closest_in_grid` does, until no cell of the next shell is nearer than
+    ``bound[i]``. Keeps the ``out_face.shape[1]`` nearest such faces (by distance),
     their closest points' barycentric coordinates ``out_bary`` (m, K, 3), distances
     ``out_d`` (m, K) and lower bounds ``out_lb`` (m, K); ``count[i]`` counts the faces that
     qualified (above K: some left out).
@@ -287,7 +290,7 @@ def faces_within(points, P, faces, eps, eps_max, ring_start, ring, lo, h, dims, 
     nmax = max(dims[0], max(dims[1], dims[2]))
     for i in prange(m):
         px, py, pz = points[i, 0], points[i, 1], points[i, 2]
-        reach = bound[i] + eps_max
+        reach = bound[i]
         n = 0
         ci, wx = _home(px, lo[0], h, dims[0])
         cj, wy = _home(py, lo[1], h, dims[1])
@@ -398,3 +401,28 @@ def _root(label, s):
         label[s] = label[label[s]]
         s = label[s]
     return s
+
+
+@kernel
+def survivor_minima(start, tri, twin, slot, out):
+    """Which survivors are nearer their query than every surviving neighbour: each point's
+    survivors (``start``, ``tri`` as in :func:`survivor_components`, sorted by their distance
+    within a point, so that an earlier survivor is as near or nearer), compared across the
+    edges that are not walls (``twin``, −1 across a wall). ``slot`` (f,) all −1 (scratch, left
+    so); ``out`` (len(tri),) bool."""
+    for i in range(start.shape[0] - 1):
+        a, b = start[i], start[i + 1]
+        for s in range(a, b):
+            slot[tri[s]] = s
+        for s in range(a, b):
+            low = True
+            t = tri[s]
+            for e in range(3):
+                h = twin[3 * t + e]
+                if h >= 0:
+                    r = slot[h // 3]
+                    if 0 <= r < s:
+                        low = False
+            out[s] = low
+        for s in range(a, b):
+            slot[tri[s]] = -1

@@ -76,6 +76,42 @@ def ring_pairs(F, n, centre, rings):
 
 
 @kernel
+def ring_pairs_within(F, n, centre, lo, hi, rings):
+    """:func:`ring_pairs` where each centre's rings lie within faces ``lo[i]:hi[i]`` (its
+    piece of a mesh of disjoint pieces): the same pairs, by scanning the piece once a ring
+    instead of grouping the whole mesh's halfedges."""
+    vtag = np.full(n, -1, np.int64)  # the centre that reached a vertex last
+    vround = np.zeros(n, np.int64)  # the ring it was reached in
+    out_n = np.empty(max(16, 32 * len(centre)), np.int64)
+    out_f = np.empty(len(out_n), np.int64)
+    size = 0
+    for i in range(len(centre)):
+        for c in range(3):
+            vtag[F[centre[i], c]] = i
+            vround[F[centre[i], c]] = 0
+        for r in range(rings):
+            for f in range(lo[i], hi[i]):
+                hit = False
+                for c in range(3):
+                    v = F[f, c]
+                    if vtag[v] == i and vround[v] <= r:
+                        hit = True
+                if not hit:
+                    continue
+                if r == rings - 1:
+                    out_n = _push(out_n, size, i)
+                    out_f = _push(out_f, size, f)
+                    size += 1
+                else:
+                    for c in range(3):
+                        v = F[f, c]
+                        if vtag[v] != i:
+                            vtag[v] = i
+                            vround[v] = r + 1
+    return out_n[:size], out_f[:size]
+
+
+@kernel
 def cut_pieces(F, twin, n, node, f):
     """The faces ``f`` of each node (pairs sorted by node, then face) copied apart.
 

@@ -21,8 +21,15 @@ walk needs is kept in flat tables:
 - per key ending a descent, the interpolation stencil's six vertices with their exact limit
   rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
 
+Keys that differ in shape alone form a *class* (the key without its shapes). The step's
+plan, rows and child connectivity are the class's, and so are the parent faces and chart
+supports that place every child corner (``child_shapes``): from a class's second key on,
+those are kept as *recipes*, and a key of a known class is not refined: its candidate maps
+and its children's shapes come from its own shapes through the recipes
+(:meth:`PatchTable._clone_steps`, :meth:`PatchTable._clone_children`).
+
 Everything is exact by construction: the tables hold the existing code's results on the
-representatives.
+representatives (the recipes' by the same operations on the same numbers).
 """
 
 from __future__ import annotations
@@ -30,9 +37,22 @@ from __future__ import annotations
 import numpy as np
 
 from .._topology import Level
-from .._refiner import barycentric
-from ._cache_kernels import canonical_order, face_records, key_hashes, regular_flags
+from .._refiner import barycentric, child_shapes, glue_maps
+from ._cache_kernels import (
+    candidate_rows,
+    canonical_order,
+    clone_rows,
+    face_records,
+    gather_pieces,
+    key_hashes,
+    regular_flags,
+    representative_rows,
+    shape_records,
+    support_codes,
+    transition_hashes,
+)
 from .descent import (
+    MAX_CHILDREN,
     Patches,
     cut_children,
     limit_rows,
@@ -42,6 +62,14 @@ from .descent import (
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
 GRID = 1e-9
+#: A key's candidate slots: its centre face's children and those of its three neighbours.
+SLOTS = 4 * MAX_CHILDREN
+#: The chart's support weights (:func:`.._refiner.plan_supports`), stored in recipes by code.
+WEIGHTS = np.array([0.0, 1.0, 0.5, 1.0 / 3.0, 2.0 / 3.0])
+#: Refined steps kept for cutting their candidates' children later.
+KEPT = 4
+#: Recipes are kept for classes of more keys than this.
+LEARN = 1
 
 
 class Grow:
@@ -53,6 +81,10 @@ class Grow:
         self.n = 0
 
     def append(self, block) -> int:
+        if self._a.dtype == np.int16:  # small indices: widened once a block needs more
+            block = np.asarray(block)
+            if len(block) and (block.max() > 32767 or block.min() < -32768):
+                self._a = self._a.astype(np.int32)
         block = np.asarray(block, self._a.dtype)
         start, end = self.n, self.n + len(block)
         if end > len(self._a):
@@ -83,7 +115,7 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
     Returns ``fperm``, ``vperm``, ``vstart`` (canonical faces and vertices, the vertex ranges
     per node), ``rec`` (m, 13) int64 per canonical face and ``norm`` (m, 3, 2) the normalised
     shapes, every face's corners from the one it was entered at (see
-    :func:`._cache_kernels.face_records`).
+    :func:`._cache_kernels.face_records`), and ``entry`` (m) that corner of every face.
     """
     F = np.ascontiguousarray(level.faces, dtype=np.int64)
     m, k = len(F), len(centre)
@@ -104,7 +136,20 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
     norm = np.empty((m, 3, 2))
     face_records(F, twin, hs.view(np.int64), level.face_sharp, np.ascontiguousarray(shape, dtype=np.float64), fperm,
                  frank, vrank, entry, fstart, node_f, scale, GRID, rec, norm)
-    return fperm, vperm, vstart, rec, norm
+    return fperm, vperm, vstart, rec, norm, entry
+
+
+def _local_supports(sh, verts: np.ndarray, off: np.ndarray):
+    """The chart supports of a step's vertices ``verts`` (``sh``: :class:`.descent.ChildShapes`)
+    over their piece's own vertices (``off``: its first, one per vertex): ids (k, 3) (−1:
+    unused) and the weights' codes into :data:`WEIGHTS` (None where one is not among them)."""
+    verts = np.ascontiguousarray(verts, dtype=np.int64).ravel()
+    sup = np.empty((len(verts), 3), np.int64)
+    code = np.empty((len(verts), 3), np.uint8)
+    off = np.ascontiguousarray(np.broadcast_to(off, verts.shape), dtype=np.int64)
+    if not support_codes(verts, off, sh.ids, sh.w, WEIGHTS, sup, code):
+        return sup, None  # pragma: no cover - the chart's supports have these weights
+    return sup, code
 
 
 class PatchTable:
@@ -122,11 +167,11 @@ class PatchTable:
         # faces, shapes), its vertices rep_v0[k]:+nv[k] (corner tags).
         self.rep_f0, self.rep_nf = Grow((), np.int64), Grow((), np.int64)
         self.rep_v0, self.rep_h0 = Grow((), np.int64), Grow((), np.int64)
-        self.rep_F, self.rep_twin = Grow((3,), np.int32), Grow((3,), np.int32)
+        self.rep_F, self.rep_twin = Grow((3,), np.int16), Grow((3,), np.int16)
         self.rep_hs = Grow((3,))
         self.rep_fs = Grow((), np.bool_)
         self.rep_corner = Grow((), np.float64 if vertex_sharpness else np.bool_)
-        self.rep_shape = Grow((3, 2))
+        self.rep_shape = Grow((3,))  # corner 1's x, corner 2's x, y: corner 0 at the origin, 1 on +x
         self.parity = Grow((), np.int8)  # per key: 1 when the next step is odd ("sqrt3" only)
         self.nv = Grow((), np.int64)
         self.cand_start = Grow((), np.int64, -1)  # per key (−1: not refined yet)
@@ -157,16 +202,39 @@ class PatchTable:
         self.st_node = Grow((9,))  # c0 (2), scale (1), the face's corners (6)
         self.st_full = Grow((), np.bool_)
         self.st_inv = Grow((6, 6))  # the inverse of the interpolation matrix
-        self._recent = None
-        self._t_index: dict[bytes, int] = {}  # a transition's contents → its first entry
-        self._t_key_bytes = 0
+        self._kept = []  # the last steps refined (:meth:`_refine`), for cutting their children
+        self._order = []  # the keys last given steps, by parity: the order children are registered in
+        self._t_index: dict[tuple, int] = {}  # a transition's contents (hashed) → its first entry
+        # Classes: keys without their shapes (connectivity, tags, parity). Per key its class;
+        # per class where its candidates' recipe starts (SLOTS rows: whether a candidate,
+        # its parent face, its corners' chart supports over the patch, their weights' codes)
+        # and per slot its cut's recipe (−1: none yet): the child key, its transition (first
+        # and end entry, hash), where its faces' rows (parent) and vertices' rows (supports,
+        # weights' codes) start.
+        self._class_index: dict[tuple, int] = {}
+        self.key_class = Grow((), np.int64)
+        self.cls_cand = Grow((), np.int64, -1)
+        self.cls_cut = Grow((SLOTS,), np.int64, -1)
+        self.ct_valid = Grow((), np.bool_)
+        self.ct_parent = Grow((), np.int16)
+        self.ct_sup = Grow((3, 3), np.int16)
+        self.ct_w = Grow((3, 3), np.uint8)
+        self.cut_child = Grow((), np.int64)
+        self.cut_t = Grow((2,), np.int64)
+        self.cut_tkey = Grow((2,), np.uint64)
+        self.cut_f0 = Grow((), np.int64)
+        self.cut_v0 = Grow((), np.int64)
+        self.cf_parent = Grow((), np.int16)
+        self.cv_sup = Grow((3,), np.int16)
+        self.cv_w = Grow((3,), np.uint8)
+        self.cls_keys = Grow((), np.int32)  # per class: its keys so far (recipes are kept from two on)
 
     @property
     def nbytes(self) -> int:
-        """What the cache holds: its arrays' capacity (they grow by half), its two dictionaries
-        estimated."""
+        """What the cache holds: its arrays' capacity (they grow by half), its three
+        dictionaries estimated."""
         grown = sum(g.capacity_bytes for g in vars(self).values() if isinstance(g, Grow))
-        return grown + 120 * (len(self.index) + len(self._t_index)) + self._t_key_bytes
+        return grown + 120 * (len(self.index) + len(self._t_index) + len(self._class_index))
 
     @property
     def n_keys(self) -> int:
@@ -182,22 +250,32 @@ class PatchTable:
             h0 = self.rep_h0.a[k]
             hs = None if h0 < 0 else self.rep_hs.a[h0:h0 + self.rep_nf.a[k]].ravel()
             out.append((self.rep_F.a[f], self.rep_twin.a[f].ravel(), hs, self.rep_fs.a[f],
-                        self.rep_corner.a[self.rep_v0.a[k]:][:self.nv.a[k]], self.rep_shape.a[f]))
+                        self.rep_corner.a[self.rep_v0.a[k]:][:self.nv.a[k]], _shapes(self.rep_shape.a[f])))
         return out
 
     def register(self, level, corner, shape, centre, fstart, parity):
         """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
         the canonical vertex orders: ``vperm``, ``vstart``."""
-        fperm, vperm, vstart, rec, norm = canonicalise(level, corner, shape, centre, fstart)
+        fperm, vperm, vstart, rec, norm, _ = canonicalise(level, corner, shape, centre, fstart)
         cv = corner[vperm]
         if cv.dtype != self.rep_corner.a.dtype:
             raise AssertionError("corner tags and the table disagree on vertex sharpness")  # pragma: no cover
-        h = np.empty((len(centre), 2), np.uint64)  # 128 bits: a collision is not a practical concern
-        bits = cv.view(np.int64) if self.vertex_sharpness else cv.astype(np.int64)  # a sharpness by its bits
-        key_hashes(rec, fstart, bits, vstart, parity, h)
         reg = np.empty(len(centre), np.int8)
         regular_flags(rec, fstart, cv != 0 if self.vertex_sharpness else cv, vstart, reg)
-        ids = np.empty(len(centre), np.int64)
+        return self._keys_of(rec, fstart, cv, vstart, norm, level.face_sharp[fperm], reg, parity), vperm, vstart
+
+    def _bits(self, cv: np.ndarray) -> np.ndarray:
+        """Corner tags as the words hashed: a sharpness by its bits."""
+        return cv.view(np.int64) if self.vertex_sharpness else cv.astype(np.int64)
+
+    def _keys_of(self, rec, fstart, cv, vstart, norm, fs, reg, parity):
+        """Key ids of pieces given canonical: face records ``rec`` (:func:`canonicalise`) of
+        faces ``fstart[i]:fstart[i + 1]``, corner tags ``cv`` of vertices
+        ``vstart[i]:vstart[i + 1]``, normalised shapes ``norm``, sharp faces ``fs``, regular
+        flags ``reg``; new keys get the piece as representative."""
+        h = np.empty((len(fstart) - 1, 2), np.uint64)  # 128 bits: a collision is not a practical concern
+        key_hashes(rec, fstart, self._bits(cv), vstart, parity, h)
+        ids = np.empty(len(h), np.int64)
         new = []
         for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):
             kid = self.index.get(key)
@@ -206,53 +284,79 @@ class PatchTable:
                 new.append(i)
             ids[i] = kid
         if new:
-            self._add_representatives(np.array(new), rec, fstart, fperm, level.face_sharp, cv, vstart, norm)
+            self._add_representatives(np.array(new), rec, fstart, fs, cv, vstart, norm, parity)
             self.parity.append(np.full(len(new), parity))
             self.regular.append(reg[new])
         n = self.n_keys
         for g in (self.cand_start, self.final, self.poly):
             g.extend_to(n)
         self.cand_count.extend_to(n)
-        return ids, vperm, vstart
+        return ids
 
-    def _add_representatives(self, new, rec, fstart, fperm, face_sharp, cv, vstart, norm):
-        """The pieces ``new`` of a batch (:meth:`register`'s arrays) become the representatives
-        of the next keys, in order."""
+    def _add_representatives(self, new, rec, fstart, fs, cv, vstart, norm, parity):
+        """The pieces ``new`` of a batch (:meth:`_keys_of`'s arrays) become the representatives
+        of the next keys, in order (:func:`._cache_kernels.representative_rows`); each key's
+        connectivity class is found (or made)."""
         nf = fstart[new + 1] - fstart[new]
         nv = vstart[new + 1] - vstart[new]
-        f = _ranges(fstart[new], nf)
-        f0 = _firsts(nf)  # each piece's first face among f
-        hs = np.ascontiguousarray(rec[f, 7:10]).view(np.float64)  # the halfedges' sharpness, rotated
-        sharp = np.add.reduceat((hs != 0).any(axis=1), f0) > 0
+        m, k = int(nf.sum()), len(new)
+        F, tw, hb = np.empty((m, 3), np.int64), np.empty((m, 3), np.int64), np.empty((m, 3), np.int64)
+        crec, fsn, shape3 = np.empty((m, 10), np.int64), np.empty(m, np.bool_), np.empty((m, 3))
+        cvn, sharp = np.empty(int(nv.sum()), cv.dtype), np.empty(k, np.bool_)
+        representative_rows(new, rec, fstart, norm, fs, cv, vstart, F, tw, fsn, shape3, hb, crec, cvn, sharp)
+        f0, v0 = _firsts(nf), _firsts(nv)
         self.rep_f0.append(self.rep_F.n + f0)
         self.rep_nf.append(nf)
-        self.rep_v0.append(self.rep_corner.n + _firsts(nv))
-        h0 = np.full(len(new), -1, np.int64)
+        self.rep_v0.append(self.rep_corner.n + v0)
+        h0 = np.full(k, -1, np.int64)
         h0[sharp] = self.rep_hs.n + _firsts(nf[sharp])
         self.rep_h0.append(h0)
-        self.rep_hs.append(hs[_ranges(f0[sharp], nf[sharp])])
-        self.rep_F.append(rec[f, :3])
-        self.rep_twin.append(rec[f, 3:6])
-        self.rep_fs.append(face_sharp[fperm[f]])
-        self.rep_shape.append(norm[f])
-        self.rep_corner.append(cv[_ranges(vstart[new], nv)])
+        self.rep_hs.append(hb[_ranges(f0[sharp], nf[sharp])].view(np.float64))
+        self.rep_F.append(F)
+        self.rep_twin.append(tw)
+        self.rep_fs.append(fsn)
+        self.rep_shape.append(shape3)
+        self.rep_corner.append(cvn)
         self.nv.append(nv)
+        # The class: the key without its shapes (connectivity, tags, parity).
+        hc = np.empty((len(new), 2), np.uint64)
+        key_hashes(crec, np.append(f0, m), self._bits(cvn), np.append(v0, len(cvn)), parity, hc)
+        cls = np.empty(len(new), np.int64)
+        for i, key in enumerate(zip(hc[:, 0].tolist(), hc[:, 1].tolist())):
+            c = self._class_index.get(key)
+            if c is None:
+                c = self._class_index[key] = len(self._class_index)
+            cls[i] = c
+        self.key_class.append(cls)
+        self.cls_cand.extend_to(len(self._class_index))
+        self.cls_cut.extend_to(len(self._class_index))
+        self.cls_keys.extend_to(len(self._class_index))
+        np.add.at(self.cls_keys.a, cls, 1)
 
     def regular_keys(self, keys: np.ndarray) -> np.ndarray:
         """Whether each key is a regular Loop patch (:func:`.regular.is_regular`)."""
         return self.regular.a[keys] == 1
 
+    def _pieces(self, keys: np.ndarray):
+        """The representatives of ``keys`` as flat arrays of disjoint pieces: faces, halfedge
+        twins, face shapes, and the face and vertex offsets of each piece
+        (:func:`._cache_kernels.gather_pieces`)."""
+        keys = np.ascontiguousarray(keys, dtype=np.int64)
+        foff = np.concatenate([[0], np.cumsum(self.rep_nf.a[keys])])
+        voff = np.concatenate([[0], np.cumsum(self.nv.a[keys])])
+        m = int(foff[-1])
+        F, tw, shape = np.empty((m, 3), np.int64), np.empty(3 * m, np.int64), np.empty((m, 3, 2))
+        gather_pieces(keys, self.rep_f0.a, self.rep_nf.a, self.rep_F.a, self.rep_twin.a, self.rep_shape.a, foff, voff,
+                      F, tw, shape)
+        return F, tw, shape, foff, voff
+
     def patches(self, keys: np.ndarray):
         """The representatives of ``keys`` as one mesh of disjoint pieces; also the face and
         vertex offsets of each piece (its centre is its first face)."""
         keys = np.asarray(keys, np.int64)
-        nf, nv = self.rep_nf.a[keys], self.nv.a[keys]
-        foff = np.concatenate([[0], np.cumsum(nf)])
-        voff = np.concatenate([[0], np.cumsum(nv)])
+        F, tw, shape, foff, voff = self._pieces(keys)
+        nf, nv = np.diff(foff), np.diff(voff)
         f = _ranges(self.rep_f0.a[keys], nf)
-        F = self.rep_F.a[f].astype(np.int64) + np.repeat(voff[:-1], nf)[:, None]
-        tw = self.rep_twin.a[f].astype(np.int64)
-        tw = np.where(tw >= 0, tw + 3 * np.repeat(foff[:-1], nf)[:, None], -1).ravel()
         h0 = self.rep_h0.a[keys]
         sharp = h0 >= 0
         hs = None
@@ -262,93 +366,294 @@ class PatchTable:
             hs = hs.ravel()
         level = Level(F, int(voff[-1]), tw, hs, self.rep_fs.a[f])
         uv = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[None], len(keys), axis=0)
-        p = Patches(level, self.rep_corner.a[_ranges(self.rep_v0.a[keys], nv)], self.rep_shape.a[f],
-                    foff[:-1].copy(), uv)
+        p = Patches(level, self.rep_corner.a[_ranges(self.rep_v0.a[keys], nv)], shape, foff[:-1].copy(), uv)
         return p, foff, voff
 
     def _refine(self, keys: np.ndarray):
         """One step of the representatives of ``keys`` (all of one parity)."""
-        p, _, voff = self.patches(keys)
+        p, foff, voff = self.patches(keys)
         plan, S, faces1, child, shapes_of, cid, ccorn = refine_patches(p, self.scheme, 2 - int(self.parity.a[keys[0]]),
                                                                        self.loop_weights)
-        return {"keys": keys, "p": p, "voff": voff, "plan": plan, "S": S.tocsr(), "faces1": faces1, "child": child,
-                "shapes_of": shapes_of, "cid": cid, "ccorn": ccorn}
+        return {"keys": keys, "p": p, "foff": foff, "voff": voff, "plan": plan, "S": S.tocsr(), "faces1": faces1,
+                "child": child, "shapes_of": shapes_of, "cid": cid, "ccorn": ccorn}
 
     def _refined(self, keys: np.ndarray):
-        """:meth:`_refine` per parity; the last result is kept for :meth:`fill_children`."""
+        """:meth:`_refine` per parity; the results are kept a while for :meth:`fill_children`."""
         out = []
         par = self.parity.a[keys]
         for b in np.unique(par):
             out.append(self._refine(keys[par == b]))
-        self._recent = out
+        self._kept = (self._kept + out)[-KEPT:]
         return out
 
     def fill_steps(self, keys: np.ndarray):
-        """The candidates of ``keys`` (unique, not refined yet): their maps ``M``."""
-        for r in self._refined(keys):
-            X = r["p"].shape[r["p"].face]  # (k, 3, 2)
-            cid, cc = r["cid"], r["ccorn"]
-            M = np.swapaxes(barycentric(cc[:, :, None], X[:, None, :, :]), 2, 3)  # (k, 24, 3 bary, 3 corners)
-            valid = cid >= 0
-            cnt = valid.sum(axis=1)
-            kk, jj = np.nonzero(valid)
-            start = self.M.append(M[kk, jj])
-            self.child.append(np.full(len(kk), -1))
-            self.owner.append(r["keys"][kk])
-            self.slot.append(jj)
-            self.t_start.append(np.zeros(len(kk), np.int64))
-            self.t_end.append(np.zeros(len(kk), np.int64))
-            self.cand_start.a[r["keys"]] = start + np.concatenate([[0], np.cumsum(cnt)[:-1]])
-            self.cand_count.a[r["keys"]] = cnt
+        """The candidates of ``keys`` (unique, not refined yet): their maps ``M``. Keys of a
+        class met before take its candidates' recipe (:meth:`_clone_steps`), the others are
+        refined. The candidates are numbered by parity, then key, whichever way they are
+        made (the order :meth:`fill_children` is given them in)."""
+        par = self.parity.a[keys]
+        self._order = [keys[par == b] for b in np.unique(par)]
+        rows = self.cls_cand.a[self.key_class.a[keys]]
+        known = rows >= 0
+        parts = []
+        if known.any():
+            parts.append((keys[known], *self._clone_steps(keys[known], rows[known])))
+        if not known.all():
+            for r in self._refined(keys[~known]):
+                X = r["p"].shape[r["p"].face]  # (k, 3, 2)
+                cid, cc = r["cid"], r["ccorn"]
+                valid = cid >= 0
+                kk, jj = np.nonzero(valid)
+                parts.append((r["keys"], valid, np.swapaxes(barycentric(cc[kk, jj][:, None], X[kk]), 1, 2)))
+                self._learn_steps(r)
+        got, valid, M = (np.concatenate(x) for x in zip(*parts))
+        order = np.concatenate(self._order)
+        perm = _position(got, order)
+        cnt = valid.sum(axis=1)
+        self._add_candidates(order, valid[perm], M[_ranges(_firsts(cnt)[perm], cnt[perm])])
+
+    def _add_candidates(self, keys, valid, M):
+        """Candidates ``valid`` (k, 24) of ``keys`` with their maps ``M`` (in that order)."""
+        cnt = valid.sum(axis=1)
+        kk, jj = np.nonzero(valid)
+        start = self.M.append(M)
+        self.child.append(np.full(len(kk), -1))
+        self.owner.append(keys[kk])
+        self.slot.append(jj)
+        self.t_start.append(np.zeros(len(kk), np.int64))
+        self.t_end.append(np.zeros(len(kk), np.int64))
+        self.cand_start.a[keys] = start + np.concatenate([[0], np.cumsum(cnt)[:-1]])
+        self.cand_count.a[keys] = cnt
+
+    def _learn_steps(self, r):
+        """The candidates' recipe of each class first refined in ``r`` (:meth:`_refine`): per
+        slot, whether there is a candidate, its parent face and the chart supports of its
+        corners over the patch."""
+        keys = r["keys"]
+        cls = self.key_class.a[keys]
+        need = np.flatnonzero((self.cls_cand.a[cls] < 0) & (self.cls_keys.a[cls] > LEARN))
+        if not len(need):
+            return
+        u, first = np.unique(cls[need], return_index=True)
+        sel = need[first]
+        sh = r["shapes_of"]
+        cid = r["cid"][sel]  # (m, 24)
+        valid = cid >= 0
+        c = np.maximum(cid, 0)
+        parent = np.where(valid, sh.parent[c] - r["foff"][sel][:, None], 0)
+        off = np.repeat(r["voff"][sel], 3 * SLOTS)
+        sup, code = _local_supports(sh, sh.faces1[c], off)
+        if code is None:  # pragma: no cover - the step's supports are these weights
+            return
+        sup, code = sup.reshape(-1, SLOTS, 3, 3), code.reshape(-1, SLOTS, 3, 3)
+        sup[~valid] = -1
+        code[~valid] = 0
+        base = self.ct_valid.append(valid.ravel())
+        self.ct_parent.append(parent.ravel())
+        self.ct_sup.append(sup.reshape(-1, 3, 3))
+        self.ct_w.append(code.reshape(-1, 3, 3))
+        self.cls_cand.a[u] = base + SLOTS * np.arange(len(u))
+
+    def _clone_steps(self, keys, rows):
+        """:meth:`fill_steps` for keys whose class's candidates are known (``rows``: where its
+        recipe starts): which candidates (k, 24) and their maps, the corners from the key's
+        own shapes by the same operations as :func:`.descent.refine_patches`
+        (``child_shapes``, the glue maps), so the same maps to the bit, without refining the
+        patch."""
+        F, tw, shape, foff, voff = self._pieces(keys)
+        slots = rows[:, None] + np.arange(SLOTS)
+        valid = self.ct_valid.a[slots]
+        kk, jj = np.nonzero(valid)
+        at = slots[kk, jj]
+        n = len(at)
+        parent, sup, w = np.empty(n, np.int64), np.empty((3 * n, 3), np.int64), np.empty((3 * n, 3))
+        candidate_rows(kk, at, foff, voff, self.ct_parent.a, self.ct_sup.a, self.ct_w.a, WEIGHTS, parent, sup, w)
+        corners = child_shapes(F, tw, shape, np.arange(3 * n).reshape(n, 3), parent, sup, w)
+        _, R, t = glue_maps(shape, tw, foff[:-1])
+        k = len(keys)
+        Rg = np.concatenate([np.broadcast_to(np.eye(2), (k, 1, 2, 2)), R], axis=1)[kk, jj // MAX_CHILDREN]
+        tg = np.concatenate([np.zeros((k, 1, 2)), t], axis=1)[kk, jj // MAX_CHILDREN]
+        cc = Rg[:, None, :, 0] * corners[..., :1] + Rg[:, None, :, 1] * corners[..., 1:]
+        cc += tg[:, None, :]
+        X = shape[foff[:-1]]
+        return valid, np.swapaxes(barycentric(cc[:, None], X[kk]), 1, 2)
 
     def fill_children(self, cands: np.ndarray):
-        """Cut the child patches of the candidates ``cands`` (unique): their keys and ``T``."""
+        """Cut the child patches of the candidates ``cands`` (unique): their keys and ``T``.
+        A candidate whose slot was cut for a key of its owner's class before takes that
+        recipe (:meth:`_clone_children`); the others are cut from their owner's step.
+
+        The pieces are registered in one order whichever way they are made: those whose
+        owner was among the last keys given steps (:meth:`fill_steps`, by parity), then the
+        others by parity (the order of refining them all again). A key's representative
+        is the first piece met with that key, so the order is part of the result."""
         owners = self.owner.a[cands]
-        recent = list(self._recent or [])
-        have = np.concatenate([r["keys"] for r in recent]) if recent else np.zeros(0, np.int64)
-        other = ~np.isin(owners, have)
-        if other.any():  # keys refined at an earlier level or call: again
-            recent += self._refined(np.unique(owners[other]))
-        for r in recent:
-            pick = np.isin(owners, r["keys"])
+        par = self.parity.a[owners]
+        groups, rest = [], np.ones(len(cands), bool)
+        for g in self._order:
+            pick = rest & np.isin(owners, g)
             if pick.any():
-                self._cut_children(r, cands[pick], owners[pick])
+                groups.append(np.flatnonzero(pick))
+                rest &= ~pick
+        if rest.any():
+            self._order = [np.unique(owners[rest & (par == b)]) for b in np.unique(par[rest])]
+            groups += [np.flatnonzero(rest & (par == b)) for b in np.unique(par[rest])]
+        tid = self.cls_cut.a[self.key_class.a[owners], self.slot.a[cands]]
+        cut = tid < 0
+        pool = list(self._kept)
+        have = np.concatenate([r["keys"] for r in pool] + [np.zeros(0, np.int64)])
+        lack = cut & ~np.isin(owners, have)
+        if lack.any():  # keys refined at an earlier level or call, or taken from their class: refined (again)
+            pool += self._refined(np.unique(owners[lack]))
+        for idx in groups:
+            parts, finish = [], []
+            known = idx[~cut[idx]]
+            if len(known):
+                parts.append(self._clone_children(cands[known], owners[known], tid[known]))
+                finish.append((self._finish_clones, known, (cands[known], tid[known])))
+            for r in pool[::-1]:  # the latest refining of an owner
+                i = idx[cut[idx] & np.isin(owners[idx], r["keys"])]
+                if len(i):
+                    cut[i] = False
+                    piece, more = self._cut_children(r, cands[i], owners[i])
+                    parts.append(piece)
+                    finish.append((self._finish_cuts, i, more))
+            where = np.concatenate([f[1] for f in finish])
+            order = np.argsort(where)  # the pieces back in the order of idx (increasing)
+            parity = int(par[idx[0]]) ^ 1 if self.scheme == "sqrt3" else 0
+            kids = self._keys_of(*_pieces_in_order(parts, order), parity)
+            at = np.empty(len(cands), np.int64)
+            at[where[order]] = np.arange(len(where))
+            for fn, i, more in finish:
+                fn(kids[at[i]], *more)
 
     def _cut_children(self, r, cands, owners):
+        """The child patches of ``cands`` cut from their owners' step ``r``: their pieces
+        (:func:`_pieces_in_order`'s parts) and what :meth:`_finish_cuts` needs once they
+        have keys."""
         node = np.searchsorted(r["keys"], owners) if _sorted(r["keys"]) else _position(r["keys"], owners)
         centre = r["cid"][node, self.slot.a[cands]]
-        nxt, corner_n, shape_n, cur, vsel, fstart = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
-                                                                 r["shapes_of"], centre)
-        parity = int(self.parity.a[owners[0]]) ^ 1 if self.scheme == "sqrt3" else 0
-        kids, vperm, vstart = self.register(nxt, corner_n, shape_n, cur, fstart, parity)
+        parent = r["shapes_of"].parent  # the refined faces by parent: a piece's are a range
+        within = (np.searchsorted(parent, r["foff"][node]), np.searchsorted(parent, r["foff"][node + 1]))
+        nxt, corner_n, shape_n, cur, vsel, fstart, f1 = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
+                                                                     r["shapes_of"], centre, within)
+        fperm, vperm, vstart, rec, norm, entry = canonicalise(nxt, corner_n, shape_n, cur, fstart)
+        cv = corner_n[vperm]
+        if cv.dtype != self.rep_corner.a.dtype:
+            raise AssertionError("corner tags and the table disagree on vertex sharpness")  # pragma: no cover
+        reg = np.empty(len(centre), np.int8)
+        regular_flags(rec, fstart, cv != 0 if self.vertex_sharpness else cv, vstart, reg)
         T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order
         # Columns: the parent piece's vertices (canonical: the representative's own order).
         row_node = np.searchsorted(vstart, T.row, side="right") - 1
         col = T.col - r["voff"][node[row_node]]
         row = T.row - vstart[row_node]
         bounds = np.searchsorted(row_node, np.arange(len(centre) + 1))
-        self._add_transitions(cands, row.astype(np.int32), col.astype(np.int32), T.data, bounds)
+        piece = (rec, norm, nxt.face_sharp[fperm], cv, np.diff(fstart), np.diff(vstart), reg)
+        return piece, (r, cands, owners, node, fstart, fperm, vstart, vperm, vsel, f1, row.astype(np.int32),
+                       col.astype(np.int32), T.data, bounds)
+
+    def _finish_cuts(self, kids, r, cands, owners, node, fstart, fperm, vstart, vperm, vsel, f1, row, col, val,
+                     bounds):
+        """:meth:`_cut_children`'s candidates given their child keys ``kids``: their
+        transitions stored, their recipes learnt."""
+        tkeys = self._add_transitions(cands, row, col, val, bounds)
         self.child.a[cands] = kids
+        self._learn_children(r, cands, owners, node, kids, fstart, fperm, vstart, vperm, vsel, f1, tkeys)
+
+    def _learn_children(self, r, cands, owners, node, kids, fstart, fperm, vstart, vperm, vsel, f1, tkeys):
+        """The recipe of each (class, slot) first cut in :meth:`_cut_children` (classes of
+        more than one key): the child's key (its connectivity and tags are those of every
+        child cut there), its transition, per canonical child face its parent face, and per
+        canonical child vertex its chart supports."""
+        cls, slot = self.key_class.a[owners], self.slot.a[cands]
+        need = np.flatnonzero((self.cls_cut.a[cls, slot] < 0) & (self.cls_keys.a[cls] > LEARN))
+        if not len(need):
+            return
+        _, first = np.unique(cls[need] * SLOTS + slot[need], return_index=True)
+        sel = need[first]
+        nf, nv = fstart[sel + 1] - fstart[sel], vstart[sel + 1] - vstart[sel]
+        sh = r["shapes_of"]
+        fr = f1[fperm[_ranges(fstart[sel], nf)]]  # the canonical child faces' refined faces
+        vr = vsel[vperm[_ranges(vstart[sel], nv)]]  # the canonical child vertices' refined vertices
+        sup, code = _local_supports(sh, vr, np.repeat(r["voff"][node[sel]], nv))
+        if code is None:  # pragma: no cover - the step's supports are these weights
+            return
+        ids = self.cut_child.append(kids[sel]) + np.arange(len(sel))
+        self.cut_t.append(np.stack([self.t_start.a[cands[sel]], self.t_end.a[cands[sel]]], axis=1))
+        self.cut_tkey.append(tkeys[sel])
+        self.cut_f0.append(self.cf_parent.n + _firsts(nf))
+        self.cut_v0.append(self.cv_sup.n + _firsts(nv))
+        self.cf_parent.append(sh.parent[fr] - np.repeat(r["foff"][node[sel]], nf))
+        self.cv_sup.append(sup)
+        self.cv_w.append(code)
+        self.cls_cut.a[cls[sel], slot[sel]] = ids
+
+    def _clone_children(self, cands, owners, tid):
+        """The child patches of candidates whose (class, slot) was cut before (``tid``: its
+        recipe), as :func:`_pieces_in_order`'s parts: the recipe's child key's connectivity
+        and tags with shapes from the owner's own (``child_shapes``, then
+        :func:`._cache_kernels.face_records`' normalisation), the same to the bit as cutting
+        them (:meth:`_cut_children`), without refining or cutting."""
+        keys, inv = np.unique(owners, return_inverse=True)
+        F, tw, shape, foff, voff = self._pieces(keys)
+        ck = self.cut_child.a[tid]  # the recipes' child keys
+        nf, nv = self.rep_nf.a[ck], self.nv.a[ck]
+        n, nn = int(nf.sum()), int(nv.sum())
+        corners, parent = np.empty((n, 3), np.int64), np.empty(n, np.int64)
+        sup, w = np.empty((nn, 3), np.int64), np.empty((nn, 3))
+        rec, fs, cv = np.empty((n, 13), np.int64), np.empty(n, np.bool_), np.empty(nn, self.rep_corner.a.dtype)
+        hbits = self.rep_hs.a.view(np.int64) if self.rep_hs.n else np.zeros((1, 3), np.int64)
+        clone_rows(ck, inv, self.cut_f0.a[tid], self.cut_v0.a[tid], foff, voff, self.cf_parent.a, self.cv_sup.a,
+                   self.cv_w.a, WEIGHTS, self.rep_f0.a, self.rep_nf.a, self.rep_v0.a, self.nv.a, self.rep_F.a,
+                   self.rep_twin.a, self.rep_fs.a, self.rep_h0.a, hbits, self.rep_corner.a, corners, parent, sup, w,
+                   rec, fs, cv)
+        shp = child_shapes(F, tw, shape, corners, parent, sup, w)
+        fstart = np.concatenate([[0], np.cumsum(nf)])
+        sc = shp[fstart[:-1]]  # the centre faces: entered at corner 0
+        scale = np.hypot(sc[:, 1, 0] - sc[:, 0, 0], sc[:, 1, 1] - sc[:, 0, 1])
+        norm = np.empty((n, 3, 2))
+        shape_records(shp, fstart, scale, GRID, rec, norm)
+        return rec, norm, fs, cv, nf, nv, self.regular.a[ck]
+
+    def _finish_clones(self, kids, cands, tid):
+        """:meth:`_clone_children`' candidates given their child keys ``kids``: their
+        transitions are their recipes'."""
+        self.child.a[cands] = kids
+        t0, t1 = self.cut_t.a[tid, 0], self.cut_t.a[tid, 1]
+        start = np.empty(len(cands), np.int64)
+        for i, key in enumerate(zip(self.cut_tkey.a[tid, 0].tolist(), self.cut_tkey.a[tid, 1].tolist())):
+            got = self._t_index.get(key)
+            if got is None:  # not shared (an index that never finds one): stored anew
+                got = self._t_index[key] = self.t_row.n
+                a, b = int(t0[i]), int(t1[i])
+                self.t_row.append(self.t_row.a[a:b].copy())
+                self.t_col.append(self.t_col.a[a:b].copy())
+                self.t_val.append(self.t_val.a[a:b].copy())
+            start[i] = got
+        self.t_start.a[cands] = start
+        self.t_end.a[cands] = start + (t1 - t0)
 
     def _add_transitions(self, cands, row, col, val, bounds):
         """Store candidate ``cands[i]``'s transition, entries ``bounds[i]:bounds[i + 1]`` of
         ``row``, ``col``, ``val``, once per distinct content: patches that differ in shape
         alone (most keys beside creases, and every input face's in a regular region) share
         their step's rows, so the table holds each once (a fifth of the entries on fandisk's
-        hybrid) and the carry reads fewer distinct ones. Contents are told apart by their
-        bytes (the weights by their bits), so sharing is exact."""
+        hybrid) and the carry reads fewer distinct ones. Contents are told apart by a 128-bit
+        hash of their entries (the weights by their bits), as keys are. Returns the hashes
+        (k, 2)."""
         n = np.diff(bounds)
         start = np.empty(len(cands), np.int64)
+        h = np.empty((len(cands), 2), np.uint64)  # 128 bits, as the keys'
+        transition_hashes(row, col, np.ascontiguousarray(val, dtype=np.float64).view(np.int64), bounds, h)
         own = []
         end = self.t_row.n  # where the next new one goes
-        for i, (a, b) in enumerate(zip(bounds[:-1].tolist(), bounds[1:].tolist())):
-            key = row[a:b].tobytes() + col[a:b].tobytes() + val[a:b].tobytes()
+        for i, key in enumerate(zip(h[:, 0].tolist(), h[:, 1].tolist())):
             at = self._t_index.get(key)
             if at is None:
                 at = self._t_index[key] = end
-                self._t_key_bytes += len(key)
                 own.append(i)
-                end += b - a
+                end += int(n[i])
             start[i] = at
         keep = _ranges(bounds[own], n[own])
         self.t_row.append(row[keep])
@@ -356,6 +661,7 @@ class PatchTable:
         self.t_val.append(val[keep])
         self.t_start.a[cands] = start
         self.t_end.a[cands] = start + n
+        return h
 
     def fill_stencils(self, keys: np.ndarray):
         """The last interpolation's data of ``keys`` (unique, none yet): stencil vertices, their
@@ -403,6 +709,13 @@ class PatchTable:
         return ids
 
 
+def _shapes(stored: np.ndarray) -> np.ndarray:
+    """Normalised face shapes (m, 3, 2) from their three stored numbers (m, 3)."""
+    out = np.zeros((len(stored), 3, 2))
+    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = stored[:, 0], stored[:, 1], stored[:, 2]
+    return out
+
+
 def _firsts(lengths: np.ndarray) -> np.ndarray:
     """Where each of consecutive runs of ``lengths`` starts: their exclusive prefix sums."""
     out = np.zeros(len(lengths), np.int64)
@@ -413,6 +726,22 @@ def _firsts(lengths: np.ndarray) -> np.ndarray:
 def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """``concatenate([arange(s, s + n) for s, n in zip(starts, lengths)])``."""
     return np.repeat(starts - _firsts(lengths), lengths) + np.arange(int(lengths.sum()))
+
+
+def _pieces_in_order(parts: list, order: np.ndarray) -> tuple:
+    """Pieces given in parts, each ``(rec, norm, fs, cv, nf, nv, reg)`` (face records, shapes
+    and sharp flags of its faces, corner tags of its vertices, per piece its faces, vertices
+    and regular flag), concatenated and then taken in ``order``: the arguments of
+    :meth:`PatchTable._keys_of` before ``parity``."""
+    if len(parts) == 1 and _sorted(order):  # one part, in order already
+        rec, norm, fs, cv, nf, nv, reg = parts[0]
+        return rec, np.concatenate([[0], np.cumsum(nf)]), cv, np.concatenate([[0], np.cumsum(nv)]), norm, fs, reg
+    rec, norm, fs, cv, nf, nv, reg = (np.concatenate(x) for x in zip(*parts))
+    fsel = _ranges(_firsts(nf)[order], nf[order])
+    vsel = _ranges(_firsts(nv)[order], nv[order])
+    nf, nv = nf[order], nv[order]
+    return (rec[fsel], np.concatenate([[0], np.cumsum(nf)]), cv[vsel], np.concatenate([[0], np.cumsum(nv)]),
+            norm[fsel], fs[fsel], reg[order])
 
 
 def _sorted(a: np.ndarray) -> bool:

@@ -102,23 +102,33 @@ class PointDepths:
         self.halving = loop_face  # a level halves the face (Loop) instead of dividing it by √3
         self.any = self.edge.any(axis=1) | np.isfinite(self.vertex).any(axis=1)
         # Beyond these distances no rule asks for more than the default (the loosest face type).
-        per_level = np.log(2.0) if loop_face.size and loop_face.all() else np.log(3.0) / 2
-        vmax = self.vertex.max() if np.isfinite(self.vertex).any() else -np.inf
-        self.reach_vertex = float(np.exp(-(default - vmax) * per_level))
-        self.reach_edge = float(np.exp(-(default - EDGE_LEVELS) * per_level)) if self.edge.any() else 0.0
+        self._per_level = np.log(2.0) if loop_face.size and loop_face.all() else np.log(3.0) / 2
+        self._vmax = self.vertex.max() if np.isfinite(self.vertex).any() else -np.inf
 
-    def __call__(self, f: np.ndarray, b: np.ndarray, depth: int) -> np.ndarray:
+    def _reach(self, base: int) -> tuple[float, float]:
+        """The distances to an irregular vertex and to a split edge beyond which no rule asks for
+        more than ``base`` levels."""
+        vertex = float(np.exp(-(base - self._vmax) * self._per_level))
+        edge = float(np.exp(-(base - EDGE_LEVELS) * self._per_level)) if self.edge.any() else 0.0
+        return vertex, edge
+
+    def __call__(self, f: np.ndarray, b: np.ndarray, depth: int, rule_depth: int | None = None) -> np.ndarray:
         """Depth of each point (face ``f``, bary ``b``) for a surface of depth ``depth``: the
         rule's depth shifted by ``depth`` − the scheme's default, between ``depth`` and
-        ``max(depth, MAX_DEPTH)``."""
+        ``max(depth, MAX_DEPTH)``. With ``rule_depth`` (deeper than ``depth``: the surface's
+        own depth), the rule is that of ``rule_depth``: points it takes deeper than ``depth``
+        keep their depth there, so a shallow evaluation (``project``'s first iterations) is off
+        by no more next to irregular vertices and split edges than elsewhere."""
         out = np.full(len(f), depth, np.int64)
         if depth >= MAX_DEPTH:
             return out
+        shift = max(depth, rule_depth if rule_depth is not None else depth) - self.default
+        reach_vertex, reach_edge = self._reach(depth - shift)
         # |p − corner i| ≥ (1 − b_i) × height and the distance to edge i is b_(i+2) × height.
         b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-        close = np.maximum(np.maximum(b0, b1), b2) > 1 - self.reach_vertex / _HEIGHT
-        if self.reach_edge > 0:
-            close |= np.minimum(np.minimum(b0, b1), b2) < self.reach_edge / _HEIGHT
+        close = np.maximum(np.maximum(b0, b1), b2) > 1 - reach_vertex / _HEIGHT
+        if reach_edge > 0:
+            close |= np.minimum(np.minimum(b0, b1), b2) < reach_edge / _HEIGHT
         near = np.flatnonzero(close & self.any[f])
         if not len(near):
             return out
@@ -138,7 +148,7 @@ class PointDepths:
                 need = np.where(near_vertex, np.maximum(need, self.vertex[fn, i] - np.log(r) / per_level), need)
         need = np.where(on_edge, np.maximum(np.minimum(need, MAX_DEPTH), ON_EDGE_DEPTH),
                         np.minimum(need, MAX_DEPTH))
-        d = np.clip(np.ceil(need).astype(np.int64) + (depth - self.default), depth, MAX_DEPTH)
+        d = np.clip(np.ceil(need).astype(np.int64) + shift, depth, MAX_DEPTH)
         d[bn.max(axis=1) >= 1 - AT_VERTEX] = depth  # the last level's vertex: its limit position, exactly
         if self.sqrt3:
             d += d % 2  # Kobbelt's boundary: even levels

@@ -26,7 +26,7 @@ from .._input import RefineInput
 from .._topology import Level, child_level, face_parents, plan_step
 from .._refiner import EQUILATERAL, barycentric, child_shapes, glue_maps, plan_supports, step_matrix
 from .._refiner.loop import next_corners
-from ._descent_kernels import cut_pieces, ring_pairs
+from ._descent_kernels import cut_pieces, ring_pairs, ring_pairs_within
 from .local import plan_vertices, refine_locally
 
 #: Vertex rings of faces around a point's face kept at every level.
@@ -82,6 +82,26 @@ def start(inp: RefineInput, faces0: np.ndarray):
     return Patches(level, corner, shape, cur, uv), sel, np.searchsorted(node, np.arange(len(faces0) + 1))
 
 
+@dataclass(frozen=True, eq=False)
+class ChildShapes:
+    """``shapes_of(faces)``: the corners of the next level's ``faces`` in their parents'
+    frames (:func:`.._refiner.child_shapes`), from one step's parts: the next level's faces
+    ``faces1``, their ``parent`` faces, the chart supports ``ids``, ``w`` of every next
+    vertex over this level's ``faces``, ``twin`` and ``shape``."""
+
+    faces: np.ndarray
+    twin: np.ndarray
+    shape: np.ndarray
+    faces1: np.ndarray
+    parent: np.ndarray
+    ids: np.ndarray
+    w: np.ndarray
+
+    def __call__(self, faces: np.ndarray) -> np.ndarray:
+        return child_shapes(self.faces, self.twin, self.shape, self.faces1[faces], self.parent[faces], self.ids,
+                            self.w)
+
+
 def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
     """Children of each node's face and of its edge-neighbours: ids (k, 24) (−1: none) and
     corners (k, 24, 3, 2) in the node face's frame; ``shapes_of(faces)`` gives child shapes."""
@@ -105,18 +125,14 @@ def _candidates(p: Patches, offsets: np.ndarray, shapes_of):
 def refine_patches(p: Patches, scheme: str, step_no: int, loop_weights: str):
     """One step of the patches ``p``: ``(plan, S, faces1, child, shapes_of, cid, ccorn)`` —
     the step's plan and matrix, the next level's faces and :class:`Level`, ``shapes_of(faces)``
-    the child faces' corners in their parents' frames, and each node's candidate children
+    the child faces' corners in their parents' frames (:class:`ChildShapes`), and each node's candidate children
     (:func:`_candidates`)."""
     lvl = p.level
     plan = plan_step(lvl, p.corner, scheme, step_no, loop_weights)
     S = step_matrix(lvl, plan)
     faces1, child, offsets = child_level(lvl, plan)
     ids, w = plan_supports(lvl.faces, plan, lvl.n_vertices)
-    parent = face_parents(offsets)
-
-    def shapes_of(faces):
-        return child_shapes(lvl.faces, lvl.twin, p.shape, faces1[faces], parent[faces], ids, w)
-
+    shapes_of = ChildShapes(lvl.faces, lvl.twin, p.shape, faces1, face_parents(offsets), ids, w)
     cid, ccorn = _candidates(p, offsets, shapes_of)
     return plan, S, faces1, child, shapes_of, cid, ccorn
 
@@ -137,21 +153,30 @@ def step(p: Patches, qnode: np.ndarray, bary: np.ndarray, scheme: str, loop_weig
     own = ccorn[qnode[first], pick[first]]  # (k', 3, 2) the chosen faces' corners, parent node frame
     lam = barycentric(p.shape[p.face[qnode[first]]][:, None], own)
     uv = lam @ p.uv[qnode[first]]
-    nxt, corner_n, shape_n, cur, vsel, _ = cut_children(p, plan, faces1, child, shapes_of, centre)
+    nxt, corner_n, shape_n, cur, vsel, _, _ = cut_children(p, plan, faces1, child, shapes_of, centre)
     return Patches(nxt, corner_n, shape_n, cur, uv), sp.csr_matrix(S)[vsel], qn.ravel(), nb
 
 
-def cut_children(p: Patches, plan, faces1: np.ndarray, child: Level, shapes_of, centre: np.ndarray):
+def cut_children(p: Patches, plan, faces1: np.ndarray, child: Level, shapes_of, centre: np.ndarray,
+                 within: tuple | None = None):
     """The patches (two rings) round the child faces ``centre`` of :func:`refine_patches`'
     step, as a new mesh of disjoint pieces: its :class:`Level`, corner mask, face shapes, each
-    piece's centre face, the refined vertex of each new vertex, where each piece's faces start."""
+    piece's centre face, the refined vertex of each new vertex, where each piece's faces start,
+    and the refined face of each new face. ``within``: per centre the range of refined faces
+    that holds its piece (``lo``, ``hi``), to look for the rings there only (a few centres
+    on a large step)."""
     corner1 = next_corners(p.corner, plan.n_new)  # semi-sharp corners decay by one a level
-    node, f = ring_faces(faces1, plan.n_new, centre)
+    if within is None:
+        node, f = ring_faces(faces1, plan.n_new, centre)
+    else:
+        node, f = ring_pairs_within(np.ascontiguousarray(faces1, dtype=np.int64), int(plan.n_new),
+                                    np.asarray(centre, dtype=np.int64), np.asarray(within[0], dtype=np.int64),
+                                    np.asarray(within[1], dtype=np.int64), RINGS)
     nxt, corner_n, vsel, fkeys = cut_patches(child, corner1, node, f)
     cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
     used, back = np.unique(f, return_inverse=True)
     fstart = np.searchsorted(node, np.arange(len(centre) + 1))
-    return nxt, corner_n, shapes_of(used)[back], cur, vsel, fstart
+    return nxt, corner_n, shapes_of(used)[back], cur, vsel, fstart, f
 
 
 def _edge_tags(level: Level, scheme: str):

@@ -69,7 +69,7 @@ class ClosestPoints:
         faces, m = self.faces, len(self.queries)
         lo, h, dims = _grid(P[self.used], P[faces])
         start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
-        cell_faces = bin_faces(P, faces, lo, h, dims, start)
+        cell_faces = bin_faces(P, faces, np.zeros(len(faces)), lo, h, dims, start)
         face = self.previous.copy()
         bary = np.zeros((m, 3))
         d2 = np.full(m, np.inf)

@@ -24,7 +24,7 @@ from .._input import RefineInput
 from .._topology import build_level
 from .._refiner import EQUILATERAL, barycentric, child_shapes, matrix_supports, onto_input_faces, refinement_of
 from ._closest_kernels import (bin_faces, closest_among, closest_in_grid, face_rings, faces_within, ring_deviation,
-                               survivor_components)
+                               survivor_components, survivor_minima)
 from .mask_plan import edge_sharpness
 from .mesh_closest import _grid
 from .limit_setup import LimitSetup
@@ -42,6 +42,13 @@ COARSE_DEPTH = 8
 COARSE_STEP, FINE_STEP = 1e-8, 1e-11
 #: Seeds whose coarse foot is within this (in diagonals) of the best go on at the full depth.
 COARSE_GAP = 1e-5
+#: A foot where the distance's curvature along some direction is below this fraction of a
+#: plane's (1 − distance × the surface's curvature there) gets runs from either side along
+#: it, at these multiples of the distance (``_weak_minima``).
+WEAK = 0.5
+WEAK_STARTS = np.array([-0.5, -0.25, 0.25, 0.5])
+#: How far a seed at a vertex starts inside its face (towards the centroid, in barycentric units).
+SEED_INSET = 0.01
 #: The longest Newton step in (u, v).
 MAX_STEP = 0.5
 #: At most this many iterations at the full depth (each costs a full descent).
@@ -150,8 +157,28 @@ def _hessian(r, Du, Dv, Duu, Duv, Dvv):
     b = b0 - np.einsum("ij,ij->i", r, Duv)
     c = c0 - np.einsum("ij,ij->i", r, Dvv)
     spd = (a > 0) & (a * c - b * b > 0)
+    full = (a, b, c)
     a, b, c = np.where(spd, a, a0), np.where(spd, b, b0), np.where(spd, c, c0)
-    return a, b, c, np.einsum("ij,ij->i", Du, r), np.einsum("ij,ij->i", Dv, r)
+    return a, b, c, np.einsum("ij,ij->i", Du, r), np.einsum("ij,ij->i", Dv, r), full, (a0, b0, c0)
+
+
+def _descent_along_negative_curvature(full, metric):
+    """The direction (du, dv) of the most negative curvature of the full Hessian ``full`` (a, b,
+    c) relative to the metric ``metric`` (Gauss–Newton's), of unit length in space, and that
+    curvature (≥ 0: none negative)."""
+    af, bf, cf = full
+    a0, b0, c0 = metric
+    A = a0 * c0 - b0 * b0
+    B = -(af * c0 + cf * a0 - 2 * bf * b0)
+    C = af * cf - bf * bf
+    A = np.where(A > 0, A, 1.0)
+    lam = (-B - np.sqrt(np.maximum(B * B - 4 * A * C, 0.0))) / (2 * A)
+    v1 = np.stack([-(bf - lam * b0), af - lam * a0])
+    v2 = np.stack([cf - lam * c0, -(bf - lam * b0)])
+    v = np.where((np.abs(v1).sum(axis=0) >= np.abs(v2).sum(axis=0))[None], v1, v2)
+    size = np.sqrt(np.maximum(a0 * v[0] ** 2 + 2 * b0 * v[0] * v[1] + c0 * v[1] ** 2, 0.0))
+    size = np.where(size > 0, size, np.inf)
+    return v[0] / size, v[1] / size, lam
 
 
 #: The direction (du, dv) along the edge opposite each corner (the corner's coordinate constant).
@@ -163,12 +190,22 @@ def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
     point on it) a step out of the face is replaced by Gauss–Newton's step along the wall, at a corner of
     two walls by none, and at a corner vertex (``cone_at`` (k, 3): the face's corners that are
     tagged corners or meet three walls or more) a step on past it by none."""
-    a, b, c, gu, gv = _hessian(r, Du, Dv, Duu, Duv, Dvv)
-    # Along a wall, Gauss–Newton's curvature: second derivatives mean little at creases.
-    a0, b0, c0 = (np.einsum("ij,ij->i", x, y) for x, y in ((Du, Du), (Du, Dv), (Dv, Dv)))
+    a, b, c, gu, gv, full, (a0, b0, c0) = _hessian(r, Du, Dv, Duu, Duv, Dvv)
     det = a * c - b * b
     det = np.where(np.abs(det) > 0, det, 1.0)
     du, dv = (c * gu - b * gv) / det, (a * gv - b * gu) / det
+    # Where the distance is stationary but not at a minimum (a saddle: between two feet on a
+    # line of symmetry, a query near a centre of curvature) Gauss–Newton's step vanishes and
+    # the run would stop there: go down the negative curvature, as far as the distance itself
+    # (the damping shortens a step that does not bring the point closer).
+    d = np.linalg.norm(r, axis=1)
+    step = np.sqrt(np.maximum(a0 * du * du + 2 * b0 * du * dv + c0 * dv * dv, 0.0))
+    nu, nv, lam = _descent_along_negative_curvature(full, (a0, b0, c0))
+    escape = (lam < 0) & (step < 1e-3 * d) & np.isfinite(nu)
+    if escape.any():
+        sign = np.where(gu * nu + gv * nv < 0, -1.0, 1.0)  # downhill, or either way at a saddle
+        du = np.where(escape, du + sign * d * nu, du)
+        dv = np.where(escape, dv + sign * d * nv, dv)
     on_wall = (bary <= 1e-10) & (walls[3 * face[:, None] + (np.arange(3) + 1) % 3] < 0)
     for _ in range(2):
         for j in range(3):
@@ -207,7 +244,7 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
         idx = np.flatnonzero(active)
         if not len(idx):
             break
-        P, *D = surface._applied(face[idx], bary[idx], 6, depth, X)
+        P, *D = surface._applied(face[idx], bary[idx], 6, depth, X, rule_depth=surface.depth)
         d = np.linalg.norm(pts[idx] - P, axis=1)
         # At a vertex or on a wall, a step that changes the distance by rounding only ends the
         # row: it circles the vertex through the faces round it, or the derivatives along a
@@ -241,10 +278,48 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
         if point is not None:
             U = np.full(point.max() + 1, np.inf)
             np.minimum.at(U, point, best_d)
-            out = active & (low - gap > U[point])
+            # (never on its own distance: a row nearer than its own bound is an evaluation off
+            # by more than the gap, not a region ruled out)
+            out = active & (low - gap > U[point]) & (best_d > U[point])
             active[out] = False
             best_d[out] = np.inf
     return best_f, best_b, best_d, Pb, G
+
+
+def _weak_minima(surface, X, q, face, bary, Qn, G, seeds: SeedMesh, max_iter: int):
+    """Feet where the distance is nearly level along one direction (the distance's curvature
+    there below ``WEAK`` of a plane's: a query near a centre of curvature) may have a nearer
+    minimum along it, within the same component: runs from either side of the foot along that
+    direction (at ``WEAK_STARTS`` × the distance), the nearest foot kept per query."""
+    r = q - Qn
+    _, _, _, _, _, full, metric = _hessian(r, *(G[:, j] for j in range(5)))
+    nu, nv, lam = _descent_along_negative_curvature(full, metric)
+    d = np.linalg.norm(r, axis=1)
+    weak = np.flatnonzero((lam < WEAK) & np.isfinite(nu) & (d > 0))
+    if not len(weak):
+        return face, bary, Qn, G
+    rows = np.repeat(weak, len(WEAK_STARTS))
+    t = np.tile(WEAK_STARTS, len(weak)) * d[rows]
+    du, dv = t * nu[rows], t * nv[rows]
+    du, dv = (x * np.minimum(1.0, MAX_STEP / np.maximum(np.hypot(du, dv), 1e-300)) for x in (du, dv))
+    b0 = bary[rows]
+    delta = np.stack([-du - dv, du, dv], axis=1)
+    F0 = surface._inp.faces
+    wall = seeds.walls[3 * face[rows][:, None] + (np.arange(3) + 1) % 3] < 0
+    cut = np.where(wall & (delta < 0), b0 / np.where(delta < 0, -delta, 1.0), 1.0).min(axis=1)
+    f2, b2 = onto_input_faces(face[rows], b0 + delta * np.minimum(cut, 1.0)[:, None], seeds.walls, F0)
+    f2, b2, _, _, _ = _iterate(surface, X, q[rows], f2, b2, min(COARSE_DEPTH, surface.depth), max_iter, COARSE_STEP,
+                               seeds)
+    f2, b2, d2, Q2, G2 = _iterate(surface, X, q[rows], f2, b2, surface.depth, min(max_iter, FINE_ITER), FINE_STEP,
+                                  seeds)
+    best = np.full(len(q), np.inf)
+    np.minimum.at(best, rows, d2)
+    for j in np.flatnonzero(d2 < d[rows]):  # (a few rows: queries near a centre of curvature)
+        i = rows[j]
+        if d2[j] == best[i] and d2[j] < d[i]:
+            face[i], bary[i], Qn[i], G[i] = f2[j], b2[j], Q2[j], G2[j]
+            d[i] = d2[j]
+    return face, bary, Qn, G
 
 
 def _frame(X: np.ndarray, seeds: SeedMesh):
@@ -262,13 +337,14 @@ def _frame(X: np.ndarray, seeds: SeedMesh):
 @dataclasses.dataclass(frozen=True, eq=False)
 class LevelState:
     """The certificate's level at one set of control positions: its vertices ``P``, their
-    limit points ``limits``, each face's ``eps`` (ε_T) and the grid of cells over the faces."""
+    limit points ``limits``, each face's ``eps`` (ε_T) and two grids of cells over the faces."""
 
     key: bytes
     P: np.ndarray
     limits: np.ndarray
     eps: np.ndarray
-    grid: tuple
+    grid: tuple  # the faces' cells: the nearest face of a point
+    certificate: tuple  # the faces' cells, their boxes grown by ε_T (certificate_grid)
 
 
 def level_state(seeds: SeedMesh, Xn: np.ndarray) -> LevelState:
@@ -279,8 +355,19 @@ def level_state(seeds: SeedMesh, Xn: np.ndarray) -> LevelState:
     ring_deviation(P, faces, seeds.ring_start, seeds.ring, eps)
     lo, h, dims = _grid(P, P[faces])  # (every vertex of a refined level is used)
     start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
-    cell_faces = bin_faces(P, faces, lo, h, dims, start)
-    return LevelState(_key(Xn), P, np.ascontiguousarray(seeds.limits @ Xn), eps, (lo, h, dims, start, cell_faces))
+    cell_faces = bin_faces(P, faces, np.zeros(len(faces)), lo, h, dims, start)
+    return LevelState(_key(Xn), P, np.ascontiguousarray(seeds.limits @ Xn), eps, (lo, h, dims, start, cell_faces),
+                      certificate_grid(P, faces, eps))
+
+
+def certificate_grid(P: np.ndarray, faces: np.ndarray, eps: np.ndarray) -> tuple:
+    """The grid of :func:`._closest_kernels.faces_within`: every face in each cell its box
+    grown by its ε_T touches, over the grown boxes' extent: ``(lo, h, dims, start, cells)``."""
+    tri = P[faces]
+    grown = np.concatenate([tri.min(axis=1) - eps[:, None], tri.max(axis=1) + eps[:, None]])
+    lo, h, dims = _grid(grown, tri)
+    start = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
+    return lo, h, dims, start, bin_faces(P, faces, eps, lo, h, dims, start)
 
 
 def _key(Xn: np.ndarray) -> bytes:
@@ -304,8 +391,7 @@ def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.nd
     closest_in_grid(pts, P, faces, lo, h, dims, start, cell_faces, f0, b0, d2)
     # An upper bound on the distance to the surface: the limit points of the nearest face's corners.
     bound = np.linalg.norm(pts[:, None, :] - state.limits[faces[f0]], axis=2).min(axis=1) * (1 + 1e-15) + 1e-12
-    point, tri, lam, dist, lb = _survivors(pts, P, faces, eps, seeds.ring_start, seeds.ring, lo, h, dims, start,
-                                       cell_faces, bound)
+    point, tri, lam, dist, lb = _survivors(pts, P, faces, eps, seeds.ring_start, seeds.ring, state.certificate, bound)
     order = np.lexsort((dist, point))
     point, tri, lam, dist, lb = point[order], tri[order], lam[order], dist[order], lb[order]
     start = np.searchsorted(point, np.arange(m + 1))
@@ -313,8 +399,11 @@ def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.nd
     survivor_components(start, tri, seeds.level_walls, np.full(len(faces), -1, np.int64), label)
     low = lb.copy()
     np.minimum.at(low, label, lb)  # each component's lower bound, at its first survivor
-    first = label == np.arange(len(tri))  # the nearest survivor of each component
-    point, tri, lam, low = point[first], tri[first], lam[first], low[first]
+    # A seed at every survivor nearer the query than its surviving neighbours (the nearest of
+    # each component among them): a component can hold several minima of the distance.
+    first = np.empty(len(tri), bool)
+    survivor_minima(start, tri, seeds.level_walls, np.full(len(faces), -1, np.int64), first)
+    point, tri, lam, low = point[first], tri[first], lam[first], low[label[first]]
     if limit is not None and len(point):  # the nearest ``limit[i]`` seeds of point i (still sorted)
         rank = np.arange(len(point)) - np.searchsorted(point, point)
         keep = rank < limit[point]
@@ -332,7 +421,7 @@ def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.nd
     return point, g, bary, low
 
 
-def _survivors(pts, P, faces, eps, ring_start, ring, lo, h, dims, start, cell_faces, bound):
+def _survivors(pts, P, faces, eps, ring_start, ring, grid, bound):
     """Every (point, triangle, bary there, distance, lower bound) with the lower bound below ``bound``: the nearest
     ``KEEP`` of each point, then again with four times as many for the points that had more."""
     out = []
@@ -345,8 +434,8 @@ def _survivors(pts, P, faces, eps, ring_start, ring, lo, h, dims, start, cell_fa
         cd = np.full((m, keep), np.inf)
         cl = np.zeros((m, keep))
         count = np.zeros(m, np.int64)
-        faces_within(np.ascontiguousarray(pts[rows]), P, faces, eps, float(eps.max()), ring_start, ring, lo, h, dims,
-                     start, cell_faces, np.ascontiguousarray(bound[rows]), cf, cb, cd, cl, count)
+        faces_within(np.ascontiguousarray(pts[rows]), P, faces, eps, ring_start, ring, *grid,
+                     np.ascontiguousarray(bound[rows]), cf, cb, cd, cl, count)
         done = count <= keep
         ok = (np.arange(keep)[None, :] < count[:, None]) & done[:, None]
         out.append((np.repeat(rows, keep)[ok.ravel()], cf[ok], cb[ok], cd[ok], cl[ok]))
@@ -372,6 +461,11 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     F0 = surface._inp.faces
     point, sf, sb, low = candidates(seeds, state, np.ascontiguousarray(q), np.where(far, FAR_SEEDS, len(F0)))
     sf, sb = onto_input_faces(sf, sb, seeds.walls, F0)
+    # A seed at a vertex starts a little inside its face: at an irregular vertex the chart's
+    # derivatives are those of the characteristic map at its centre (zero or unbounded), and
+    # a Newton step from there goes nowhere useful (a run that belongs at the vertex returns).
+    at = sb.max(axis=1) >= 1 - 1e-9
+    sb[at] = (1 - SEED_INSET) * sb[at] + SEED_INSET / 3
     many = q[point]
     coarse = min(COARSE_DEPTH, surface.depth)
     face, bary, d, Pc, _ = _iterate(surface, Xn, many, sf, sb, coarse, max_iter, COARSE_STEP, seeds, point, low,
@@ -388,6 +482,7 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     order = np.lexsort((d, point))
     pick = order[np.r_[True, point[order][1:] != point[order][:-1]]]
     face, bary, Qn, G = face[pick], bary[pick], Qn[pick], G[pick]
+    face, bary, Qn, G = _weak_minima(surface, Xn, q, face, bary, Qn, G, seeds, max_iter)
     Q = centre + scale * Qn
     N = np.cross(G[:, 0], G[:, 1])
     e = pts - Q

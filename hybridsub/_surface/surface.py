@@ -17,8 +17,10 @@ from .depth import PointDepths
 from .project import closest_points, seed_setup
 from .walk import StartKeys, walk_points, walk_rows
 
-#: Points followed down together (bounds the memory of one pass).
+#: Points followed down together at most (bounds the memory of one pass).
 CHUNK = 20000
+#: The first chunk of a new patch cache, before its growth per point is known.
+FIRST_CHUNK = 4096
 #: The patch cache is emptied between chunks once it holds about this many bytes.
 CACHE_BYTES = 2**28
 
@@ -185,6 +187,7 @@ class LimitSurface:
         self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels,
                                  vertex_sharpness=self._inp.corner_sharpness is not None)
         self._starts = StartKeys(self._inp, self._table)
+        self._chunk = getattr(self, "_chunk", CHUNK)
 
     def _rows(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
         return walk_rows(self._table, self._starts, f, b, 3 if derivatives else 1, self._depths(f, b, depth))
@@ -232,13 +235,23 @@ class LimitSurface:
         return tuple(out) if derivatives else out[0]
 
     def _chunks(self, f: np.ndarray, b: np.ndarray, work) -> list:
-        """``work(f, b)`` on chunks of ``CHUNK`` points; the patch cache emptied before a chunk
-        once it holds more than ``CACHE_BYTES``."""
+        """``work(f, b)`` on chunks of points; the patch cache emptied before a chunk once it
+        holds more than ``CACHE_BYTES``. A chunk is sized so that the cache grows by at most
+        half that during it, at the growth per point of the last chunk (``FIRST_CHUNK`` points
+        on an empty cache, at most ``CHUNK``): points whose keys rarely repeat (the hybrid
+        beside creases, some 30 kB a point) go in smaller chunks, the cap holding within a call."""
         out = []
-        for i in range(0, len(f), CHUNK):
+        i = 0
+        while i < len(f):
             if self._table.nbytes > CACHE_BYTES:
                 self._new_cache()
-            out.append(work(f[i:i + CHUNK], b[i:i + CHUNK]))
+            size = self._chunk if self._table.n_keys else min(self._chunk, FIRST_CHUNK)
+            before = self._table.nbytes
+            out.append(work(f[i:i + size], b[i:i + size]))
+            done = min(size, len(f) - i)
+            i += size
+            grown = max(self._table.nbytes - before, 0) / done
+            self._chunk = CHUNK if grown * CHUNK <= CACHE_BYTES / 2 else max(int(CACHE_BYTES / 2 / grown), min(256, CHUNK))
         return out
 
     def _matrix(self, f: np.ndarray, b: np.ndarray, derivatives: bool, depth: int):
@@ -281,12 +294,13 @@ class LimitSurface:
         res = res.reshape((n_rows, len(f)) + X.shape[1:])
         return tuple(res) if derivatives else res[0]
 
-    def _applied(self, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, X: np.ndarray) -> np.ndarray:
+    def _applied(self, f: np.ndarray, b: np.ndarray, n_rows: int, depth: int, X: np.ndarray,
+                 rule_depth: int | None = None) -> np.ndarray:
         """The first ``n_rows`` of value, ∂/∂u, ∂/∂v, ∂²/∂u², ∂²/∂u∂v, ∂²/∂v² applied to the
-        data ``X`` (n, d): (n_rows, k, d)."""
+        data ``X`` (n, d): (n_rows, k, d). ``rule_depth``: see :class:`.depth.PointDepths`."""
         X2 = writable(np.ascontiguousarray(X, dtype=np.float64))
         parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
-                                                              self._depths(fc, bc, depth), X2))
+                                                              self._depths(fc, bc, depth, rule_depth), X2))
         return np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
