@@ -569,6 +569,53 @@ def test_inputs_are_not_written_to():
     assert np.array_equal(V, V0) and np.array_equal(F, F0)
 
 
+@pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
+def test_memory_limit_refuses_the_step_that_would_not_fit(scheme):
+    """``max_memory`` as ``refine`` takes it: a limit below what a step needs refuses that step
+    by name (its level, the faces it would refine), before allocating it; ``"none"`` and a
+    limit above what the run needs give the default's refinement. The estimate is checked
+    against the memory the run really takes (tracemalloc's peak, an independent count):
+    it must not be below it."""
+    import tracemalloc
+
+    V, F = hybridsub.load_example()
+    where = np.arange(3000)
+    want = hybridsub.refine_adaptive(F, where=where, levels=4, scheme=scheme)
+    tracemalloc.start()
+    hybridsub.refine_adaptive(F, where=where, levels=4, scheme=scheme, max_memory="none")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    with pytest.raises(hybridsub.OutputTooLargeError, match=r"refining [\d,]+ of the [\d,]+ faces at level \d"):
+        hybridsub.refine_adaptive(F, where=where, levels=4, scheme=scheme, max_memory=peak)
+    with pytest.raises(hybridsub.OutputTooLargeError, match="at level 0 .* set by max_memory"):
+        hybridsub.refine_adaptive(F, where=where, levels=4, scheme=scheme, max_memory="1M")
+    for mm in ("none", 2 * peak + 10**8):
+        r = hybridsub.refine_adaptive(F, where=where, levels=4, scheme=scheme, max_memory=mm)
+        assert np.array_equal(r.faces, want.faces) and np.array_equal(r.face_level, want.face_level)
+    with pytest.raises(hybridsub.OutputTooLargeError, match="or a looser tolerance"):
+        hybridsub.subdivide_adaptive(V, F, tolerance="0.05%", scheme=scheme, max_memory="20M")
+    with pytest.raises(ValueError, match="max_memory"):
+        hybridsub.refine_adaptive(F, where=where, levels=1, scheme=scheme, max_memory="lots")
+
+
+def test_memory_limit_from_the_environment(monkeypatch, tmp_path, capsys):
+    """The process-wide limits apply too (``HYBRIDSUB_MAX_MEMORY``), and the command line
+    answers with the message and exit code 1 (``--force`` turns the check off, as it does for
+    uniform levels)."""
+    from hybridsub._app.cli import main
+    V, F = hybridsub.load_example()
+    monkeypatch.setenv("HYBRIDSUB_MAX_MEMORY", "5M")
+    with pytest.raises(hybridsub.OutputTooLargeError, match="HYBRIDSUB_MAX_MEMORY"):
+        hybridsub.refine_adaptive(F, where=np.arange(3000), levels=3)
+    src = os.path.join(DATA, "cube-meshed.off")
+    out = tmp_path / "a.obj"
+    monkeypatch.setenv("HYBRIDSUB_MAX_MEMORY", "100k")
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.1%"]) == 1
+    assert "adaptive refinement" in capsys.readouterr().err and not out.exists()
+    assert main(["subdivide", src, "-o", str(out), "--tolerance", "0.1%", "--force"]) == 0
+    assert out.exists()
+
+
 # ------------------------------------------------------------------------------------------
 # The command line
 # ------------------------------------------------------------------------------------------

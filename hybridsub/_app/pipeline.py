@@ -448,7 +448,8 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
             res = adaptive_result(mesh.vertices, mesh.faces, tolerance=opts.tolerance, max_levels=opts.max_levels,
                                   scheme=opts.scheme, loop_weights=opts.loop_weights, boundary=opts.boundary,
                                   holes=mesh.holes if len(mesh.holes) else None,
-                                  non_manifold=opts.non_manifold, **feat.tags())
+                                  non_manifold=opts.non_manifold, max_memory="none" if opts.force else None,
+                                  **feat.tags())
     except MeshError as e:
         raise PipelineError(f"{path}: {e}") from None
     except ValueError as e:

@@ -43,6 +43,7 @@ from .._input import RefineInput
 from .._topology import Level, build_level, child_level, plan_step
 from .refinement import Refinement, RefinementStep, _compose_cut
 from .._rules.step_rules import EDGE_TRISECT
+from .budget import RegionBudget
 from .stencils import step_matrix
 
 
@@ -356,6 +357,7 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
     want = np.minimum(np.asarray(want0, np.int64), max_levels)
     steps, st = [], None
     missed, missed_level = [], []
+    budget = RegionBudget(max_levels, inp.scheme, inp.max_memory)
     for k in range(max_levels + 1):
         act = mesh.active(k)
         if on_level is not None:
@@ -370,7 +372,10 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
         region = need & act
         if k == max_levels or not region.any():
             break
+        trisect = int((mesh.twin.reshape(-1, 3)[region] < 0).sum()) if scheme == "sqrt3" and k % 2 else 0
+        budget.check(k, len(mesh.faces), mesh.n_vertices, int(region.sum()), trisect)
         mesh, st = refine_region(mesh, region, k, scheme, inp.loop_weights)
+        budget.add(st.faces, st.matrix)
         want = want[st.face_parent]
         pairs, sharp = edge_tags(mesh)
         steps.append(RefinementStep(st.faces, st.matrix, pairs, sharp, inp.faces_out(mesh.face_sharp),

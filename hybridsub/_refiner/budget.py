@@ -346,6 +346,58 @@ class Budget:
         )
 
 
+class RegionBudget:
+    """The memory check of an adaptive refinement: ``check`` before each step of a region.
+
+    The output is not known ahead (a tolerance decides it level by level), so each step is
+    checked as it comes: what the steps so far keep (``kept``, their exact sizes), plus upper
+    bounds on the next step's. A step that refines ``r`` faces of an adaptive mesh of ``m``
+    faces and ``n`` vertices makes at most ``m + 5 r`` faces (a smooth face with three split
+    edges makes six) and ``n + 4 r + b`` vertices (a face point and at most three edge points
+    per refined face, one more on each of the ``b`` boundary edges Kobbelt's step trisects),
+    and its matrix at most
+    ``n + 3 r`` entries for the old vertices (one each, a row of ``1 + valence`` for those all
+    of whose faces are refined, their valences summing to at most ``3 r``) and four per new
+    one. The next mesh (twins and tags per halfedge, per-face levels) and the step's
+    temporaries are counted at twice the faces' and vertices' arrays.
+    """
+
+    def __init__(self, max_levels: int, scheme: str, max_memory=None):
+        self.max_levels = max_levels
+        self.scheme = scheme
+        self.limit, self.source = _resolve(max_memory)
+        self.kept = 0.0
+
+    def estimate(self, m: int, n: int, r: int, b: int = 0) -> Estimate:
+        m1, n1 = m + 5 * r, n + 4 * r + b
+        nnz = n + 3 * r + 4 * (n1 - n)
+        idx = 8 if max(nnz, n1) >= _stencils.INT32_LIMIT else 4
+        step = m1 * (24 + 8 + 1) + nnz * (8 + idx) + (n1 + 1) * idx
+        mesh = m1 * (24 + 48 + 8 + 8 + 1 + 1 + 8) + 16 * n1
+        return Estimate(int(n1), int(m1), int(nnz), self.kept + step + 2 * mesh + 2 * 24 * n1)
+
+    def check(self, k: int, m: int, n: int, r: int, b: int = 0) -> None:
+        """Refuse (OutputTooLargeError) the step that refines ``r`` of the ``m`` faces of
+        level ``k`` (``b``: the boundary edges it trisects) if it would not fit."""
+        if not math.isfinite(self.limit):
+            return
+        est = self.estimate(m, n, r, b)
+        if est.bytes > self.limit:
+            suggestion = _suggest(est.bytes)
+            raise OutputTooLargeError(
+                f"adaptive refinement (scheme {self.scheme!r}): refining {r:,} of the {m:,} faces at level {k} "
+                f"would bring the output to up to {est.faces:,} faces and {est.vertices:,} vertices and need about "
+                f"{bytes_and_count(est.bytes)} of memory (estimated before allocating, with the steps so far), more "
+                f"than the limit of {bytes_and_count(self.limit)} set by {self.source}. Ask for fewer levels "
+                f"(levels=, max_levels=) or a looser tolerance, or raise the limit: max_memory={suggestion!r} in "
+                f"this call, hybridsub.set_memory_limit({suggestion!r}) for the process, or the environment "
+                f"variable {ENV_VAR}={suggestion}; 'none' turns the check off")
+
+    def add(self, faces: np.ndarray, matrix) -> None:
+        """Count a step made: its faces, face parents, sharp-face mask and matrix."""
+        self.kept += faces.shape[0] * (24 + 8 + 1) + matrix.data.nbytes + matrix.indices.nbytes + matrix.indptr.nbytes
+
+
 def _suggest(nbytes: float) -> str:
     """A round limit above ``nbytes``, as a string like '24G'."""
     gb = max(1, math.ceil(1.25 * nbytes / 1e9))

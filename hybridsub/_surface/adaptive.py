@@ -19,7 +19,7 @@ from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
-from .._typing import ArrayLike, Boundary, LoopWeights, NonManifold, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .local import corner_mask, semi_sharp
 from .mask_plan import plan_level
 from .surface import LimitSurface
@@ -312,13 +312,14 @@ def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
                     sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
-                    holes: ArrayLike | None = None, non_manifold: NonManifold = "raise") -> AdaptiveResult:
+                    holes: ArrayLike | None = None, non_manifold: NonManifold = "raise",
+                    max_memory: MemoryLimit = None) -> AdaptiveResult:
     """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
     command line)."""
     X = as_vertices(V)
     ml = _max_levels(max_levels)
     inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes, non_manifold)
+                corner_sharpness, boundary, holes, non_manifold, max_memory)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
 
@@ -344,10 +345,12 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-          corner_sharpness=None, boundary="edge_only", holes=None, non_manifold="raise") -> RefineInput:
+          corner_sharpness=None, boundary="edge_only", holes=None, non_manifold="raise",
+          max_memory=None) -> RefineInput:
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
-                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold)
+                    corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold,
+                    max_memory=max_memory)
     return inp
 
 
@@ -375,7 +378,7 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     n_vertices: int | None = None, corner_sharpness: ArrayLike | None = None,
                     boundary: Boundary = "edge_only", holes: ArrayLike | None = None,
-                    non_manifold: NonManifold = "raise") -> Refinement:
+                    non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None) -> Refinement:
     """Refine only where it matters: a region to a level, or everywhere to a tolerance.
 
     Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
@@ -413,6 +416,10 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         With ``tolerance``: measure the faces with their corners at their limit positions
         (the output of :func:`subdivide_adaptive` with ``limit=True``); else at their level
         positions (``apply(V)``).
+    max_memory : int, float or str, optional
+        As for :func:`hybridsub.refine`; the output is not known ahead, so each step is
+        checked before it allocates, with what the steps so far keep and upper bounds on its
+        own (``OutputTooLargeError`` names the level and the faces it would refine).
 
     Returns
     -------
@@ -437,12 +444,12 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         X = as_vertices(V)
         ml = _max_levels(max_levels)
         inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
-                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold)
+                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold, max_memory)
         return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
     if levels is None:
         raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
     inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes, non_manifold)
+                corner_sharpness, boundary, holes, non_manifold, max_memory)
     mask = _where_mask(where, inp.n_faces)
     run = adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels)
     return without_holes(run.refinement, inp.hole)
@@ -453,8 +460,8 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
                        sharpness: ArrayLike | None = None, sharp_faces: ArrayLike | None = None,
                        corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                        corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
-                       holes: ArrayLike | None = None,
-                       non_manifold: NonManifold = "raise") -> tuple[np.ndarray, np.ndarray]:
+                       holes: ArrayLike | None = None, non_manifold: NonManifold = "raise",
+                       max_memory: MemoryLimit = None) -> tuple[np.ndarray, np.ndarray]:
     """Subdivide until the mesh is within ``tolerance`` of the limit surface, only where needed.
 
     Each face is refined until the largest distance between it and the limit surface over it,
@@ -480,6 +487,8 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     limit : bool
         True (default): the output vertices at their limit positions; False: at the positions
         of their levels.
+    max_memory : int, float or str, optional
+        As for :func:`refine_adaptive`.
 
     Returns
     -------
@@ -497,5 +506,5 @@ def subdivide_adaptive(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None
     res = adaptive_result(V, F, sharp_edges, tolerance=tolerance, max_levels=max_levels, limit=limit, scheme=scheme,
                           sharpness=sharpness, sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
                           corner_sharpness=corner_sharpness, boundary=boundary, holes=holes,
-                          non_manifold=non_manifold)
+                          non_manifold=non_manifold, max_memory=max_memory)
     return res.positions.copy(), res.refinement.faces.copy()
