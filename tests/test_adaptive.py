@@ -242,6 +242,17 @@ def _book(n=4):
     return V[first], inv.ravel()[F]
 
 
+def _cut_tolerance_run(V, F, scheme, tags):
+    """The book cut apart and refined to 0.3 % of its diagonal, with no warning: the positions,
+    the refinement (the same faces) and each vertex's uniform vertex."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
+        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
+    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
+    return V2, r, uniform_match(V, F, tags, scheme, r, r.apply(V))
+
+
 @pytest.mark.parametrize("scheme", ["hybrid", "loop", "sqrt3"])
 def test_non_manifold_cut_is_exact(scheme):
     # non_manifold="cut" as refine takes it: the region's vertices are the uniform refinement's
@@ -254,12 +265,7 @@ def test_non_manifold_cut_is_exact(scheme):
     r = hybridsub.refine_adaptive(F, where=np.arange(12), levels=2, scheme=scheme, **tags)
     uniform_match(V, F, tags, scheme, r, r.apply(V))
     assert r.face_level.max() == 2 and r.face_level.min() == 0
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
-        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
-    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
-    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    V2, r, index = _cut_tolerance_run(V, F, scheme, tags)
     from hybridsub._input import open_gate
     cut = open_gate(F, tags["sharp_edges"], 0, scheme=scheme, non_manifold="cut")  # the cut copy
     for j in range(int(r.vertex_level.max()) + 1):
@@ -276,12 +282,7 @@ def test_cut_tolerance_with_edge_and_corner(scheme):
     # criterion's surface pins them too, so the tolerance is reached, at the limit positions.
     V, F = _book()
     tags = dict(non_manifold="cut", boundary="edge_and_corner")
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        V2, F2 = hybridsub.subdivide_adaptive(V, F, tolerance="0.3%", scheme=scheme, **tags)
-        r = hybridsub.refine_adaptive(F, V=V, tolerance="0.3%", scheme=scheme, **tags)
-    assert np.array_equal(F2, r.faces) and r.vertex_level.max() >= 2
-    index = uniform_match(V, F, tags, scheme, r, r.apply(V))
+    V2, r, index = _cut_tolerance_run(V, F, scheme, tags)
     from hybridsub._input import open_gate
     cut = open_gate(F, None, 0, scheme=scheme, non_manifold="cut")
     corners = {} if scheme == "sqrt3" else dict(corners=np.flatnonzero(cut.corner))

@@ -253,15 +253,21 @@ class PatchTable:
                         self.rep_corner.a[self.rep_v0.a[k]:][:self.nv.a[k]], _shapes(self.rep_shape.a[f])))
         return out
 
-    def register(self, level, corner, shape, centre, fstart, parity):
-        """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
-        the canonical vertex orders: ``vperm``, ``vstart``."""
-        fperm, vperm, vstart, rec, norm, _ = canonicalise(level, corner, shape, centre, fstart)
+    def _canonical(self, level, corner, shape, centre, fstart):
+        """:func:`canonicalise`'s output, the pieces' corner tags in canonical order and their
+        regular flags (:func:`regular_flags`)."""
+        fperm, vperm, vstart, rec, norm, entry = canonicalise(level, corner, shape, centre, fstart)
         cv = corner[vperm]
         if cv.dtype != self.rep_corner.a.dtype:
             raise AssertionError("corner tags and the table disagree on vertex sharpness")  # pragma: no cover
         reg = np.empty(len(centre), np.int8)
         regular_flags(rec, fstart, cv != 0 if self.vertex_sharpness else cv, vstart, reg)
+        return fperm, vperm, vstart, rec, norm, entry, cv, reg
+
+    def register(self, level, corner, shape, centre, fstart, parity):
+        """Key ids of the pieces of ``level`` (new keys get the piece as representative) and
+        the canonical vertex orders: ``vperm``, ``vstart``."""
+        fperm, vperm, vstart, rec, norm, _, cv, reg = self._canonical(level, corner, shape, centre, fstart)
         return self._keys_of(rec, fstart, cv, vstart, norm, level.face_sharp[fperm], reg, parity), vperm, vstart
 
     def _bits(self, cv: np.ndarray) -> np.ndarray:
@@ -537,12 +543,7 @@ class PatchTable:
         within = (np.searchsorted(parent, r["foff"][node]), np.searchsorted(parent, r["foff"][node + 1]))
         nxt, corner_n, shape_n, cur, vsel, fstart, f1 = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
                                                                      r["shapes_of"], centre, within)
-        fperm, vperm, vstart, rec, norm, entry = canonicalise(nxt, corner_n, shape_n, cur, fstart)
-        cv = corner_n[vperm]
-        if cv.dtype != self.rep_corner.a.dtype:
-            raise AssertionError("corner tags and the table disagree on vertex sharpness")  # pragma: no cover
-        reg = np.empty(len(centre), np.int8)
-        regular_flags(rec, fstart, cv != 0 if self.vertex_sharpness else cv, vstart, reg)
+        fperm, vperm, vstart, rec, norm, entry, cv, reg = self._canonical(nxt, corner_n, shape_n, cur, fstart)
         T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order
         # Columns: the parent piece's vertices (canonical: the representative's own order).
         row_node = np.searchsorted(vstart, T.row, side="right") - 1
