@@ -357,7 +357,7 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
     want = np.minimum(np.asarray(want0, np.int64), max_levels)
     steps, st = [], None
     missed, missed_level = [], []
-    budget = RegionBudget(max_levels, inp.scheme, inp.max_memory)
+    budget = RegionBudget(inp.scheme, inp.max_memory)
     for k in range(max_levels + 1):
         act = mesh.active(k)
         if on_level is not None:

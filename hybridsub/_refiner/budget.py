@@ -355,15 +355,13 @@ class RegionBudget:
     faces and ``n`` vertices makes at most ``m + 5 r`` faces (a smooth face with three split
     edges makes six) and ``n + 4 r + b`` vertices (a face point and at most three edge points
     per refined face, one more on each of the ``b`` boundary edges Kobbelt's step trisects),
-    and its matrix at most
-    ``n + 3 r`` entries for the old vertices (one each, a row of ``1 + valence`` for those all
+    and its matrix at most ``n + 3 r`` entries for the old vertices (one each, a row of ``1 + valence`` for those all
     of whose faces are refined, their valences summing to at most ``3 r``) and four per new
     one. The next mesh (twins and tags per halfedge, per-face levels) and the step's
     temporaries are counted at twice the faces' and vertices' arrays.
     """
 
-    def __init__(self, max_levels: int, scheme: str, max_memory=None):
-        self.max_levels = max_levels
+    def __init__(self, scheme: str, max_memory=None):
         self.scheme = scheme
         self.limit, self.source = _resolve(max_memory)
         self.kept = 0.0
