@@ -40,11 +40,23 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._input import RefineInput
-from .._topology import Level, build_level, child_level, plan_step
+from .._topology import Level, build_level, child_level, plan_step, seam_halfedges
+from .._topology.uv import new_uv_corners
 from .refinement import Refinement, RefinementStep, _compose_cut
-from .._rules.step_rules import EDGE_TRISECT
+from .._rules.step_rules import EDGE_SPLIT, EDGE_TRISECT
 from .budget import RegionBudget
+from .linear_uv import linear_uv_matrix
 from .stencils import step_matrix
+
+
+@dataclass(frozen=True, eq=False)
+class AdaptiveUV:
+    """The face-varying (UV) index mesh of an adaptive mesh: UV faces aligned row by row."""
+
+    faces: np.ndarray  # (m, 3) int64 UV index of each face corner
+    n_uvs: int
+    corner: np.ndarray  # (t,) bool: UV indices kept as corners (``uv_start``'s, and new ones in "boundaries")
+    mode: str  # the face-varying interpolation ("all": linear)
 
 
 @dataclass(eq=False)
@@ -63,6 +75,7 @@ class AdaptiveMesh:
     # (n,) bool corners, or with semi-sharp corners (``corner_sharpness=``) float64: each input
     # vertex's sharpness at level 0 (inf a corner, 0 none), spent one a level (:func:`corners_at`)
     corner: np.ndarray
+    uv: AdaptiveUV | None = None
 
     def active(self, k: int) -> np.ndarray:
         """(m,) faces that a step from level k may refine."""
@@ -78,6 +91,7 @@ class RegionStep:
     matrix: sp.csr_matrix
     face_parent: np.ndarray  # (m',) the face of the previous adaptive mesh that emitted each face
     source: np.ndarray  # (n' - n,) what made each new point: face f (f), or edge of halfedge h (m + h, h the lower)
+    uv_matrix: sp.csr_matrix | None = None  # (t', t) with face-varying data
 
     @property
     def n_vertices(self) -> int:
@@ -89,8 +103,11 @@ def start(inp: RefineInput) -> AdaptiveMesh:
     level = inp.level
     m, n = inp.n_faces, inp.n_vertices
     corner = inp.corner if inp.corner_sharpness is None else inp.corner_sharpness
+    uv = None
+    if inp.uv is not None and inp.uv.corner is not None:
+        uv = AdaptiveUV(inp.uv.faces, inp.uv.n_uvs, inp.uv.corner.copy(), inp.uv.mode)
     return AdaptiveMesh(inp.faces, n, level.twin, level.hsharp, inp.face_sharp.copy(), np.zeros(m, np.int64),
-                        np.ones(m, bool), np.arange(m, dtype=np.int64), np.zeros(n, np.int64), corner.copy())
+                        np.ones(m, bool), np.arange(m, dtype=np.int64), np.zeros(n, np.int64), corner.copy(), uv)
 
 
 def corners_at(corner: np.ndarray, levels) -> np.ndarray:
@@ -206,6 +223,65 @@ def _kobbelt_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, loop_weights
     return rf, sub_faces, sub_ids, local, plan, faces_c, 3 * np.arange(nr + 1), S, kept_new, closure
 
 
+@dataclass(frozen=True, eq=False)
+class _UVRegion:
+    """The UV index mesh of a region: its level (twins cut along seams and R's border), the
+    UV indices it uses, their local numbers, and the step planned on it."""
+
+    ids: np.ndarray
+    local: np.ndarray
+    level: Level
+    seams: np.ndarray  # (3r,) bool: the region's seam halfedges, split by the geometry's step
+
+
+def _uv_region(uv: AdaptiveUV, rf: np.ndarray, level: Level) -> _UVRegion:
+    T = uv.faces[rf]
+    ids = np.unique(T.ravel())
+    local = np.full(uv.n_uvs, -1, np.int64)
+    local[ids] = np.arange(len(ids))
+    Ts = local[T]
+    seams = seam_halfedges(level, Ts)
+    uvl = Level(Ts, len(ids), np.where(seams, -1, level.twin), level.hsharp, level.face_sharp)
+    return _UVRegion(ids, local, uvl, seams)
+
+
+def _uv_step(mesh: AdaptiveMesh, ur: _UVRegion, plan, k: int, scheme: str, loop_weights: str, hb: np.ndarray,
+             promoted: np.ndarray, ok: np.ndarray, keep_f: np.ndarray, order: np.ndarray):
+    """The UV step of a region, with the geometry's kept rows: a UV edge point where the
+    geometry keeps the edge point (else closed onto the UV index of its halfedge's origin, as
+    the geometry closes it), a UV index promoted where its vertex is (every UV index there is
+    then refined with its whole UV star). Returns the next :class:`AdaptiveUV` and the (t', t)
+    matrix."""
+    uv, uvl = mesh.uv, ur.level
+    t, ns = uv.n_uvs, len(ur.ids)
+    uv_plan = plan_step(uvl, uv.corner[ur.ids], scheme, k + 1, loop_weights, force_split=plan.hkind == EDGE_SPLIT)
+    if not np.array_equal(uv_plan.hkind, plan.hkind):
+        raise AssertionError("UV index mesh and geometry disagree on split edges")  # pragma: no cover
+    faces_c = child_level(uvl, uv_plan, want_topology=False)[0]
+    S = linear_uv_matrix(uvl, uv_plan) if uv.mode == "all" else step_matrix(uvl, uv_plan).tocsr()
+    ep = uv_plan.edge_point.astype(np.int64)
+    dropped = np.zeros(uv_plan.n_new, bool)
+    target = np.arange(uv_plan.n_new, dtype=np.int64)
+    dropped[ep[hb]] = True
+    target[ep[hb]] = uvl.faces.ravel()[hb]
+    kept_new = np.flatnonzero(~dropped[ns:]) + ns
+    to_mesh = np.empty(uv_plan.n_new, np.int64)
+    to_mesh[:ns] = ur.ids
+    to_mesh[dropped] = ur.ids[target[dropped]]
+    to_mesh[kept_new] = t + np.arange(len(kept_new))
+    t1 = t + len(kept_new)
+    # A UV index moves with its vertex (all its corners' vertices promoted): its level is its vertex's.
+    used = np.bincount(uv.faces.ravel(), minlength=t)
+    with_promoted = np.bincount(uv.faces.ravel()[promoted[mesh.faces.ravel()]], minlength=t)
+    M = _region_matrix(S, ur.ids, ur.local, (used == with_promoted) & (used > 0), kept_new, t, t1)
+    faces1 = np.concatenate([uv.faces[keep_f], to_mesh[faces_c][ok]])[order]
+    added = np.zeros(len(kept_new), bool)
+    if uv.mode == "boundaries":  # new values on UV boundary edges are corners too
+        added = new_uv_corners(uvl, uv_plan, ns)[kept_new - ns]
+    corner = np.concatenate([uv.corner, added])
+    return AdaptiveUV(np.ascontiguousarray(faces1, dtype=np.int64), t1, corner, uv.mode), M
+
+
 def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
                   loop_weights: str) -> tuple[AdaptiveMesh, RegionStep]:
     """Refine the active faces ``region`` (m,) bool of level ``k`` once (see the module).
@@ -223,7 +299,9 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
         rf, sub_ids, local, level, border = _region_level(mesh, region)
         sub_faces = rf
         ns, Fs = len(sub_ids), level.faces
-        plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), scheme, k + 1, loop_weights)
+        ur = None if mesh.uv is None else _uv_region(mesh.uv, rf, level)
+        plan = plan_step(level, corners_at(mesh.corner[sub_ids], k), scheme, k + 1, loop_weights,
+                         force_split=None if ur is None else ur.seams)  # seams are split, never flipped
         faces_c, child, offsets = child_level(level, plan)
         S = step_matrix(level, plan).tocsr()
         n_sub_new = plan.n_new
@@ -280,10 +358,14 @@ def refine_region(mesh: AdaptiveMesh, region: np.ndarray, k: int, scheme: str,
     vertex_level = np.concatenate([mesh.vertex_level, np.full(n1 - n, k + 1, np.int64)])
     vertex_level[prom] = k + 1
     corner = np.concatenate([mesh.corner, np.zeros(n1 - n, mesh.corner.dtype)])
+    uv = uv_matrix = None
+    if mesh.uv is not None:
+        uv, uv_matrix = _uv_step(mesh, ur, plan, k, scheme, loop_weights, hb, promoted, ok, keep_f, order)
     faces1 = np.ascontiguousarray(faces1, dtype=np.int64)
     twin1 = build_level(faces1, n1).twin
-    out = AdaptiveMesh(faces1, n1, twin1, hsharp, face_sharp, face_level, genuine, face_parent, vertex_level, corner)
-    return out, RegionStep(faces1, M, emitter, source)
+    out = AdaptiveMesh(faces1, n1, twin1, hsharp, face_sharp, face_level, genuine, face_parent, vertex_level, corner,
+                       uv)
+    return out, RegionStep(faces1, M, emitter, source, uv_matrix)
 
 
 def grow(mesh: AdaptiveMesh, mask: np.ndarray, rings: int) -> np.ndarray:
@@ -324,6 +406,24 @@ def edge_tags(mesh: AdaptiveMesh) -> tuple[np.ndarray, np.ndarray]:
     return pairs.astype(np.int64), s[keep]
 
 
+def uv_edge_tags(mesh: AdaptiveMesh) -> tuple[np.ndarray, np.ndarray]:
+    """The tagged creases carried onto the UV index mesh: its interior edges (not seams) as
+    UV index pairs, with their sharpness (as :func:`edge_tags`)."""
+    if mesh.hsharp is None:
+        return np.empty((0, 2), np.int64), np.empty(0)
+    T = mesh.uv.faces
+    h = np.arange(len(mesh.twin))
+    t = mesh.twin
+    tv = T.ravel()
+    nxt = 3 * (h // 3) + (h % 3 + 1) % 3
+    tn = 3 * (np.maximum(t, 0) // 3) + (np.maximum(t, 0) % 3 + 1) % 3
+    own = (t > h) & (tv[h] == tv[tn]) & (tv[nxt] == tv[np.maximum(t, 0)])  # inside the UV mesh: no seam
+    s = np.maximum(mesh.hsharp[h[own]], mesh.hsharp[t[own]])
+    keep = s > 0
+    hh = h[own][keep]
+    return np.stack([tv[hh], tv[nxt[hh]]], axis=1).astype(np.int64), s[keep]
+
+
 #: Vertex rings per level of difference: what one more step needs around a face (a √3 flip
 #: reaches into the neighbour face, whose far vertex's ring must be refined too).
 RINGS = {"loop": 1, "hybrid": 2, "sqrt3": 2}
@@ -355,7 +455,7 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
         scheme = "hybrid"
     rings = RINGS[inp.scheme]
     want = np.minimum(np.asarray(want0, np.int64), max_levels)
-    steps, st = [], None
+    steps, uv_steps, st = [], [], None
     missed, missed_level = [], []
     budget = RegionBudget(inp.scheme, inp.max_memory)
     for k in range(max_levels + 1):
@@ -373,18 +473,28 @@ def adaptive_pass(inp: RefineInput, want0: np.ndarray, max_levels: int, on_level
         if k == max_levels or not region.any():
             break
         trisect = int((mesh.twin.reshape(-1, 3)[region] < 0).sum()) if scheme == "sqrt3" and k % 2 else 0
-        budget.check(k, len(mesh.faces), mesh.n_vertices, int(region.sum()), trisect)
+        budget.check(k, len(mesh.faces), mesh.n_vertices, int(region.sum()), trisect,
+                     None if mesh.uv is None else mesh.uv.n_uvs)
         mesh, st = refine_region(mesh, region, k, scheme, inp.loop_weights)
-        budget.add(st.faces, st.matrix)
+        budget.add(st.faces, st.matrix, st.uv_matrix)
         want = want[st.face_parent]
         pairs, sharp = edge_tags(mesh)
-        steps.append(RefinementStep(st.faces, st.matrix, pairs, sharp, inp.faces_out(mesh.face_sharp),
-                                    corners_left(mesh)[0], st.face_parent))
+        sf = inp.faces_out(mesh.face_sharp)
+        uv_faces = None if mesh.uv is None else mesh.uv.faces
+        steps.append(RefinementStep(st.faces, st.matrix, pairs, sharp, sf, corners_left(mesh)[0], st.face_parent,
+                                    uv_faces, st.uv_matrix))
+        if mesh.uv is not None:
+            uv_steps.append(RefinementStep(uv_faces, st.uv_matrix, *uv_edge_tags(mesh), sf,
+                                           np.flatnonzero(mesh.uv.corner), st.face_parent))
     pairs, sharp = edge_tags(mesh)
     face_parent = mesh.face_parent.copy()
     corners_out, corner_sharpness = corners_left(mesh)
+    uv = None
+    if mesh.uv is not None:
+        uv = Refinement(mesh.uv.faces, *uv_edge_tags(mesh), inp.faces_out(mesh.face_sharp),
+                        np.flatnonzero(mesh.uv.corner), face_parent.copy(), uv_steps, inp.uv.n_uvs, inp.max_memory)
     r = Refinement(mesh.faces, pairs, sharp, inp.faces_out(mesh.face_sharp), corners_out, face_parent, steps,
-                   inp.n_vertices, inp.max_memory, None, coarse_faces=inp.faces if inp.cut is None else None,
+                   inp.n_vertices, inp.max_memory, uv, coarse_faces=inp.faces if inp.cut is None else None,
                    face_level=mesh.face_level.copy(), vertex_level=mesh.vertex_level.copy(),
                    corner_sharpness=corner_sharpness)
     r = _compose_cut(inp, r)  # non_manifold="cut": the first step takes the caller's vertices

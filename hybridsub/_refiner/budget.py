@@ -358,7 +358,9 @@ class RegionBudget:
     and its matrix at most ``n + 3 r`` entries for the old vertices (one each, a row of ``1 + valence`` for those all
     of whose faces are refined, their valences summing to at most ``3 r``) and four per new
     one. The next mesh (twins and tags per halfedge, per-face levels) and the step's
-    temporaries are counted at twice the faces' and vertices' arrays.
+    temporaries are counted at twice the faces' and vertices' arrays. With face-varying data
+    (``t`` UV values) the UV step is bounded the same way (a UV face per face, a face point and
+    at most three edge points per refined face, a seam's two sides apart).
     """
 
     def __init__(self, scheme: str, max_memory=None):
@@ -366,20 +368,26 @@ class RegionBudget:
         self.limit, self.source = _resolve(max_memory)
         self.kept = 0.0
 
-    def estimate(self, m: int, n: int, r: int, b: int = 0) -> Estimate:
+    def estimate(self, m: int, n: int, r: int, b: int = 0, t: int | None = None) -> Estimate:
         m1, n1 = m + 5 * r, n + 4 * r + b
         nnz = n + 3 * r + 4 * (n1 - n)
         idx = 8 if max(nnz, n1) >= _stencils.INT32_LIMIT else 4
         step = m1 * (24 + 8 + 1) + nnz * (8 + idx) + (n1 + 1) * idx
         mesh = m1 * (24 + 48 + 8 + 8 + 1 + 1 + 8) + 16 * n1
-        return Estimate(int(n1), int(m1), int(nnz), self.kept + step + 2 * mesh + 2 * 24 * n1)
+        total = self.kept + step + 2 * mesh + 2 * 24 * n1
+        if t is not None:  # the UV index mesh's faces, matrix and corner mask, and their temporaries
+            t1 = t + 4 * r
+            uv_nnz = t + 3 * r + 4 * (t1 - t)
+            total += 3 * m1 * 24 + uv_nnz * (8 + idx) + (t1 + 1) * idx + 2 * t1
+        return Estimate(int(n1), int(m1), int(nnz), total)
 
-    def check(self, k: int, m: int, n: int, r: int, b: int = 0) -> None:
+    def check(self, k: int, m: int, n: int, r: int, b: int = 0, t: int | None = None) -> None:
         """Refuse (OutputTooLargeError) the step that refines ``r`` of the ``m`` faces of
-        level ``k`` (``b``: the boundary edges it trisects) if it would not fit."""
+        level ``k`` (``b``: the boundary edges it trisects; ``t``: the UV values, with
+        face-varying data) if it would not fit."""
         if not math.isfinite(self.limit):
             return
-        est = self.estimate(m, n, r, b)
+        est = self.estimate(m, n, r, b, t)
         if est.bytes > self.limit:
             suggestion = _suggest(est.bytes)
             raise OutputTooLargeError(
@@ -391,9 +399,12 @@ class RegionBudget:
                 f"this call, hybridsub.set_memory_limit({suggestion!r}) for the process, or the environment "
                 f"variable {ENV_VAR}={suggestion}; 'none' turns the check off")
 
-    def add(self, faces: np.ndarray, matrix) -> None:
-        """Count a step made: its faces, face parents, sharp-face mask and matrix."""
+    def add(self, faces: np.ndarray, matrix, uv_matrix=None) -> None:
+        """Count a step made: its faces, face parents, sharp-face mask and matrix (and with
+        face-varying data its UV faces and UV matrix)."""
         self.kept += faces.shape[0] * (24 + 8 + 1) + matrix.data.nbytes + matrix.indices.nbytes + matrix.indptr.nbytes
+        if uv_matrix is not None:
+            self.kept += faces.shape[0] * 24 + uv_matrix.data.nbytes + uv_matrix.indices.nbytes + uv_matrix.indptr.nbytes
 
 
 def _suggest(nbytes: float) -> str:

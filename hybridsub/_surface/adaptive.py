@@ -19,7 +19,7 @@ from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
-from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme
+from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
 from .local import corner_mask, semi_sharp
 from .mask_plan import plan_level
 from .surface import LimitSurface
@@ -313,13 +313,16 @@ def adaptive_result(V: ArrayLike, F: ArrayLike, sharp_edges: ArrayLike | None = 
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     corner_sharpness: ArrayLike | None = None, boundary: Boundary = "edge_only",
                     holes: ArrayLike | None = None, non_manifold: NonManifold = "raise",
-                    max_memory: MemoryLimit = None) -> AdaptiveResult:
+                    max_memory: MemoryLimit = None, uv_faces: ArrayLike | None = None, n_uvs: int | None = None,
+                    uv_mode: UVMode = "linear") -> AdaptiveResult:
     """:func:`subdivide_adaptive`'s work, with the refinement and the error reached (for the
-    command line)."""
+    command line; with ``uv_faces`` the refinement carries the UV index mesh)."""
     X = as_vertices(V)
     ml = _max_levels(max_levels)
     inp = _gate(F, sharp_edges, ml, len(X), scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes, non_manifold, max_memory)
+                corner_sharpness, boundary, holes, non_manifold, max_memory,
+                _uv_args(uv_faces, n_uvs, uv_mode, None))
+    _no_hybrid_seams(inp)
     return _by_tolerance(inp, X, tolerance, ml, bool(limit))
 
 
@@ -346,12 +349,29 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
           corner_sharpness=None, boundary="edge_only", holes=None, non_manifold="raise",
-          max_memory=None) -> RefineInput:
+          max_memory=None, uv=None) -> RefineInput:
     inp = open_gate(F, sharp_edges, levels, n_vertices=n_vertices, scheme=scheme, sharpness=sharpness,
                     sharp_faces=sharp_faces, corners=corners, loop_weights=loop_weights,
                     corner_sharpness=corner_sharpness, boundary=boundary, holes=holes, non_manifold=non_manifold,
-                    max_memory=max_memory)
+                    max_memory=max_memory, **(uv or {}))
     return inp
+
+
+def _uv_args(uv_faces, n_uvs, uv_mode, uv_interpolation) -> dict | None:
+    """The face-varying options as the gate takes them (None without ``uv_faces``; the gate
+    refuses ``n_uvs`` without them, and checks the modes either way)."""
+    if uv_faces is None and n_uvs is None and uv_mode == "linear" and uv_interpolation is None:
+        return None
+    return dict(uv_faces=uv_faces, n_uvs=n_uvs, uv_mode=uv_mode, uv_interpolation=uv_interpolation)
+
+
+def _no_hybrid_seams(inp: RefineInput) -> None:
+    """A tolerance with UVs takes ``"loop"``: the hybrid splits seams where it would flip them,
+    a surface other than the one the error is measured against."""
+    if inp.uv is not None and inp.scheme != "loop":
+        raise ValueError('a tolerance with uv_faces= needs scheme="loop": the hybrid splits UV seams where it '
+                         "flips other edges, a surface other than the limit surface the error is measured on; "
+                         "refine a region (where=, levels=), or refine the UVs with scheme=\"loop\"")
 
 
 def _surface_boundary(inp: RefineInput) -> str:
@@ -378,7 +398,9 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
                     corners: ArrayLike | None = None, loop_weights: LoopWeights = "loop",
                     n_vertices: int | None = None, corner_sharpness: ArrayLike | None = None,
                     boundary: Boundary = "edge_only", holes: ArrayLike | None = None,
-                    non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None) -> Refinement:
+                    non_manifold: NonManifold = "raise", max_memory: MemoryLimit = None,
+                    uv_faces: ArrayLike | None = None, n_uvs: int | None = None, uv_mode: UVMode = "linear",
+                    uv_interpolation: str | None = None) -> Refinement:
     """Refine only where it matters: a region to a level, or everywhere to a tolerance.
 
     Two forms. ``where=`` and ``levels=``: the input faces in ``where`` are refined ``levels``
@@ -420,13 +442,20 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         As for :func:`hybridsub.refine`; the output is not known ahead, so each step is
         checked before it allocates, with what the steps so far keep and upper bounds on its
         own (``OutputTooLargeError`` names the level and the faces it would refine).
+    uv_faces, n_uvs, uv_mode, uv_interpolation
+        Face-varying data (UVs with seams), as for :func:`hybridsub.refine`: the UV index
+        mesh is refined with the geometry's steps (seams split, never flipped), so
+        ``uv_faces`` stays aligned with ``faces`` row by row and ``uv_refinement.apply(UV)``
+        gives each UV value where the uniform refinement of its vertex's level puts it.
+        With a tolerance only ``scheme="loop"`` (the hybrid's seams change its surface).
 
     Returns
     -------
     Refinement
         As from ``refine``, plus ``face_level`` and ``vertex_level``; ``steps`` are the
         adaptive steps (each step's ``face_parent`` is the face of the previous adaptive mesh
-        that made the face).
+        that made the face); with ``uv_faces`` also ``uv_faces``, ``uv_matrix`` and
+        ``uv_refinement``.
 
     Examples
     --------
@@ -436,6 +465,7 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
     >>> int(r.face_level.max()), len(r.faces) < len(hybridsub.refine(F, levels=2, scheme="loop").faces)
     (2, True)
     """
+    uv = _uv_args(uv_faces, n_uvs, uv_mode, uv_interpolation)
     if tolerance is not None or V is not None:
         if where is not None or levels is not None:
             raise ValueError("refine_adaptive takes where= with levels=, or V= with tolerance=, not both")
@@ -444,12 +474,14 @@ def refine_adaptive(F: ArrayLike, sharp_edges: ArrayLike | None = None, *, where
         X = as_vertices(V)
         ml = _max_levels(max_levels)
         inp = _gate(F, sharp_edges, ml, len(X) if n_vertices is None else n_vertices, scheme, sharpness,
-                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold, max_memory)
+                    sharp_faces, corners, loop_weights, corner_sharpness, boundary, holes, non_manifold, max_memory,
+                    uv)
+        _no_hybrid_seams(inp)
         return _by_tolerance(inp, X, tolerance, ml, bool(limit)).refinement
     if levels is None:
         raise ValueError("refine_adaptive needs levels= with where= (or V= with tolerance=)")
     inp = _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
-                corner_sharpness, boundary, holes, non_manifold, max_memory)
+                corner_sharpness, boundary, holes, non_manifold, max_memory, uv)
     mask = _where_mask(where, inp.n_faces)
     run = adaptive_refinement(inp, mask.astype(np.int64) * inp.levels, inp.levels)
     return without_holes(run.refinement, inp.hole)
