@@ -434,13 +434,21 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
                   path: str) -> tuple[TaggedMesh, float, str]:
     """Adaptive refinement of ``mesh`` to ``opts.tolerance``: the refined mesh (positions at
     the limit, colours by the refinement's matrix, tags), the seconds it took, and the line
-    that says what it made. Texture coordinates are dropped (with a note)."""
+    that says what it made. Texture coordinates are refined with ``--scheme loop`` and dropped
+    (with a note) otherwise."""
     import warnings
 
     from .._surface.adaptive import AdaptiveWarning, adaptive_result
 
-    if mesh.uv is not None:
-        say(opts, "note: texture coordinates dropped: adaptive refinement does not refine face-varying data yet")
+    keep_uv = mesh.uv is not None and mesh.face_uv is not None and opts.scheme == "loop"
+    if mesh.uv is not None and not keep_uv:
+        if opts.uv_mode is not None:
+            raise PipelineError(f"--uv-mode with --tolerance needs --scheme loop ({path} has UVs): the hybrid splits "
+                                "UV seams where it flips other edges, a surface the tolerance is not measured on, "
+                                "and Kobbelt's √3 flips every edge")
+        say(opts, "note: texture coordinates dropped: to a tolerance they are refined with --scheme loop (the hybrid "
+                  "splits UV seams, a surface the tolerance is not measured on; √3 flips every edge)")
+    uv_args = dict(uv_faces=mesh.face_uv, n_uvs=len(mesh.uv), uv_mode=opts.uv_mode or "linear") if keep_uv else {}
     t = time.perf_counter()
     try:
         with warnings.catch_warnings(record=True) as caught:
@@ -449,7 +457,7 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
                                   scheme=opts.scheme, loop_weights=opts.loop_weights, boundary=opts.boundary,
                                   holes=mesh.holes if len(mesh.holes) else None,
                                   non_manifold=opts.non_manifold, max_memory="none" if opts.force else None,
-                                  **feat.tags())
+                                  **uv_args, **feat.tags())
     except MeshError as e:
         raise PipelineError(f"{path}: {e}") from None
     except ValueError as e:
@@ -464,7 +472,10 @@ def adaptive_mesh(opts: FileOptions, mesh: TaggedMesh, feat: FileFeatures,
     sf = np.asarray(r.sharp_faces)
     sf = (np.flatnonzero(sf) if sf.dtype == bool else sf) if opts.scheme == "hybrid" else np.empty(0, np.int64)
     fm = None if mesh.face_material is None else mesh.face_material[r.face_parent]
-    out = TaggedMesh(res.positions, r.faces, r.sharp_edges, r.sharpness, r.corners, sf, colors,
+    uv = face_uv = None
+    if keep_uv:
+        uv, face_uv = r.uv_refinement.apply(mesh.uv), r.uv_faces
+    out = TaggedMesh(res.positions, r.faces, r.sharp_edges, r.sharpness, r.corners, sf, colors, uv, face_uv,
                      material_libs=mesh.material_libs, materials=mesh.materials, face_material=fm)
     counts = np.bincount(r.face_level)
     per = ", ".join(f"{c:,} at {j}" for j, c in enumerate(counts) if c)
