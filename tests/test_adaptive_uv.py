@@ -105,6 +105,23 @@ def test_bunny_region_with_seams(scheme):
         assert check_uvs(V, F, UV, FUV, {}, scheme, r, mode) > 3 * len(F)
 
 
+@pytest.mark.parametrize("scheme", ["hybrid", "loop"])
+def test_non_manifold_cut_with_uvs(scheme):
+    """A third face on one of the bunny's edges, refined with ``non_manifold="cut"``: the cut
+    copy's UVs are the uniform cut refinement's, corner by corner, in and round the region."""
+    V, F, UV, FUV = _bunny()
+    F = np.vstack([F, [[F[0, 0], F[0, 1], len(V)]]])
+    V = np.vstack([V, V[F[0]].mean(axis=0) + 0.01])
+    FUV = np.vstack([FUV, [[FUV[0, 0], FUV[0, 1], len(UV)]]])
+    UV = np.vstack([UV, UV[:1] + 0.01])
+    far = np.linalg.norm(V - V[F[0]].mean(axis=0), axis=1)
+    where = (far[F] < np.quantile(far, 0.3)).all(axis=1)
+    assert where[-1]  # the third face is refined
+    r = hybridsub.refine_adaptive(F, where=where, levels=3, scheme=scheme, non_manifold="cut", uv_faces=FUV,
+                                  uv_interpolation="all")
+    assert check_uvs(V, F, UV, FUV, {"non_manifold": "cut"}, scheme, r, "all") > 3 * len(F)
+
+
 def test_loop_tolerance_with_uvs():
     """To a tolerance (Loop): the geometry of the run without UVs, the UVs exact; the hybrid
     (whose seams change its surface) and √3 are refused by name."""
