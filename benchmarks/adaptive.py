@@ -11,6 +11,8 @@
    bound on the time of the level as close).
 2. Selective: a patch of 15 % of the faces refined 3 levels, against uniform level 3.
 3. Throughput of the topology pass (refine_adaptive, one thread): output faces per second.
+4. Face-varying data (one thread): the textured bunny of the tests (its UV seams), the 15 %
+   patch to 3 levels and Loop to 0.1 % of the diagonal, with and without ``uv_faces=``.
 
 The tolerance and selective parts run on the default threads, the throughput on one.
 
@@ -114,12 +116,34 @@ def throughput_row(name, scheme, levels):
                 rate=len(r.faces) / best)
 
 
+def uv_row(scheme):
+    d = np.load(os.path.join(ROOT, "tests", "data", "bunny10k_textured.fvar_linear.L1.npz"))
+    V, F, FUV = d["V_in"], d["F_in"], d["FUV_in"]
+    c = V[F].mean(axis=1)
+    where = np.argsort(np.linalg.norm(c - c[0], axis=1))[: int(0.15 * len(F))]
+    calls = {"patch": dict(where=where, levels=3)}
+    if scheme == "loop":
+        calls["0.1%"] = dict(V=V, tolerance="0.1%")
+    out = {}
+    for what, kw in calls.items():
+        for uv in (False, True):
+            extra = dict(uv_faces=FUV) if uv else {}
+            r = hybridsub.refine_adaptive(F, scheme=scheme, **kw, **extra)
+            best = np.inf
+            for _ in range(3):
+                t = time.perf_counter()
+                hybridsub.refine_adaptive(F, scheme=scheme, **kw, **extra)
+                best = min(best, time.perf_counter() - t)
+            out[what, uv] = (len(r.faces), best)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--meshes", default="fandisk,cube-meshed")
     ap.add_argument("--schemes", default=",".join(SCHEMES))
     ap.add_argument("--quick", action="store_true", help="uniform levels up to 3M faces only")
-    ap.add_argument("--only", choices=("tolerance", "selective", "throughput"))
+    ap.add_argument("--only", choices=("tolerance", "selective", "throughput", "uv"))
     a = ap.parse_args()
     names = a.meshes.split(",")
     print(f"# hybridsub {hybridsub.__version__}, {cpu_name()}, {os.cpu_count()} cores")
@@ -150,6 +174,14 @@ def main():
             o = throughput_row("fandisk", scheme, 4 if scheme == "loop" else 5)
             print(f"fandisk      {scheme:7} L{o['levels']}: {o['faces']:>10,} faces in {o['seconds']:.3f} s = "
                   f"{o['rate'] / 1e6:.2f} M faces/s", flush=True)
+
+    if a.only in (None, "uv"):
+        hybridsub.set_threads(1)
+        print("\n## with UVs (uv_faces=), the textured bunny (9,999 faces, 1,289 seams), one thread")
+        for scheme in ("hybrid", "loop"):
+            for (what, uv), (n, t) in uv_row(scheme).items():
+                print(f"bunny        {scheme:7} {what:6} {'with UVs' if uv else 'no UVs':9} {n:>9,} faces "
+                      f"{t * 1e3:8.1f} ms", flush=True)
 
 
 if __name__ == "__main__":
