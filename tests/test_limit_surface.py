@@ -399,3 +399,58 @@ def test_a_mesh_without_faces_has_an_empty_surface():
     s = hybridsub.LimitSurface(np.zeros((3, 3)), np.zeros((0, 3), int))
     P, Du, Dv = s.evaluate(np.zeros(0, int), np.zeros((0, 3)), derivatives=True)
     assert P.shape == Du.shape == (0, 3) and s.evaluation_matrix(np.zeros(0, int), np.zeros((0, 3))).shape == (0, 3)
+
+
+def _on_crease_edges(tags, V, F, levels=2):
+    """The level-``levels`` vertices inside input edges that are split edges beside a √3 face of
+    the hybrid, as (face, bary) of their input face, and their sector normals on that face's side
+    from the vertices' tangent masks (``limit_normals(per_face_corner=True)``)."""
+    from hybridsub._surface.edge_fit import on_split_edge
+
+    s = hybridsub.LimitSurface(V, F, **tags)
+    r = hybridsub.refine(F, levels=levels, **tags)
+    f0, b0 = r.vertex_origin
+    idx, _ = on_split_edge(s._depths, f0, b0)
+    NC = hybridsub.limit_normals(V, F, levels=levels, per_face_corner=True, **tags)
+    fp = np.asarray(r.face_parent)
+    ref = []
+    for v in idx:
+        rows, cols = np.nonzero(r.faces == v)
+        side = np.flatnonzero(fp[rows] == f0[v])[0]
+        ref.append(NC[rows[side], cols[side]])
+    return s, f0[idx], b0[idx], np.array(ref)
+
+
+@pytest.mark.parametrize("name", ["fandisk-creases", "border-hybrid"])
+def test_normals_on_the_hybrids_creases_are_the_tangent_masks(name):
+    """On a split edge beside a √3 face the chart has no derivative across the edge (the walk's
+    grew with the depth and its normals were up to 93° off on fandisk's creases): evaluate fits
+    exact values there (``edge_fit.py``). Oracle: the refined vertices on those edges, their
+    sector normals from the tangent masks; at the default depth."""
+    if name == "fandisk-creases":
+        V, F = hybridsub.load_example()
+        feat = hybridsub.detect_features(V, F, angle=30)
+        tags = dict(scheme="hybrid", sharp_edges=feat.sharp_edges, corners=feat.corners)
+    else:
+        m = hybridsub.read_mesh(pathlib.Path(__file__).parent / "data" / "mesh_with_border.off")
+        V, F = np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+        tags = dict(scheme="hybrid")
+    s, face, bary, ref = _on_crease_edges(tags, V, F)
+    pick = np.random.default_rng(0).permutation(len(face))[:400]
+    face, bary, ref = face[pick], bary[pick], ref[pick]
+    assert len(face) >= 200
+    angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", s.normals(face, bary), ref), -1, 1)))
+    assert angle.max() < 0.5 and np.median(angle) < 0.01, (angle.max(), np.median(angle))
+    # Along the edge the derivative is the crease curve's: central differences of exact values.
+    k = np.argmin(bary, axis=1)
+    along = np.zeros_like(bary)
+    along[np.arange(len(k)), (k + 1) % 3], along[np.arange(len(k)), (k + 2) % 3] = 1.0, -1.0
+    _, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    De = along[:, 1:2] * Du + along[:, 2:3] * Dv
+    h = 1e-4
+    fd = (s.evaluate(face, bary + h * along) - s.evaluate(face, bary - h * along)) / (2 * h)
+    assert np.abs(De - fd).max() < 1e-6 * np.abs(fd).max()
+    # The rows say the same, to the fit's rounding (the values' over its step, 1e-5 of a face).
+    M, Mu, Mv = s.evaluation_matrix(face[:50], bary[:50], derivatives=True)
+    assert np.abs(Mu @ V - Du[:50]).max() < 1e-7 * np.abs(Du).max()
+    assert np.abs(Mv @ V - Dv[:50]).max() < 1e-7 * np.abs(Dv).max()

@@ -14,6 +14,7 @@ from .._input import as_vertices, open_gate, writable
 from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .cache import PatchTable
 from .depth import PointDepths
+from .edge_fit import combine, combine_rows, on_split_edge, samples
 from .project import closest_points, seed_setup
 from .walk import StartKeys, walk_points, walk_rows
 
@@ -259,6 +260,17 @@ class LimitSurface:
         parts = list(zip(*chunks)) or [()] * (3 if derivatives else 1)
         n = self._inp.n_vertices
         mats = [a[0] if len(a) == 1 else sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
+        idx, k = on_split_edge(self._depths, f, b) if derivatives else (np.zeros(0, np.int64), None)
+        if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
+            pts, W = samples(b[idx], k)
+            vals = self._matrix(np.tile(f[idx], 6), pts.reshape(-1, 3), False, depth)
+            new = combine_rows(W, [vals[j * len(idx):(j + 1) * len(idx)] for j in range(6)], 3)
+            keep = np.ones(len(f))
+            keep[idx] = 0.0
+            put = sp.csr_matrix((np.ones(len(idx)), (idx, np.arange(len(idx)))), shape=(len(f), len(idx)))
+            mats[1:] = [sp.csr_matrix(sp.diags(keep) @ M + put @ D) for M, D in zip(mats[1:], new)]
+            for M in mats[1:]:
+                M.eliminate_zeros()  # the replaced rows
         for M in mats:
             M.sum_duplicates()
             M.sort_indices()
@@ -301,7 +313,13 @@ class LimitSurface:
         X2 = writable(np.ascontiguousarray(X, dtype=np.float64))
         parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
                                                               self._depths(fc, bc, depth, rule_depth), X2))
-        return np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
+        res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
+        idx, k = on_split_edge(self._depths, f, b) if n_rows == 3 else (np.zeros(0, np.int64), None)
+        if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
+            pts, W = samples(b[idx], k)
+            vals = self._applied(np.tile(f[idx], 6), pts.reshape(-1, 3), 1, depth, X2, rule_depth)[0]
+            res[1:, idx] = combine(W, vals.reshape(6, len(idx), -1), n_rows)
+        return res
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
         """Unit normals ``∂P/∂u × ∂P/∂v`` (k, 3) (one-sided at creases: the given face's side).
