@@ -401,7 +401,7 @@ def test_a_mesh_without_faces_has_an_empty_surface():
     assert P.shape == Du.shape == (0, 3) and s.evaluation_matrix(np.zeros(0, int), np.zeros((0, 3))).shape == (0, 3)
 
 
-def _on_crease_edges(tags, V, F, levels=2):
+def split_edge_vertices(tags, V, F, levels=2):
     """The level-``levels`` vertices inside input edges that are split edges beside a √3 face of
     the hybrid, as (face, bary) of their input face, and their sector normals on that face's side
     from the vertices' tangent masks (``limit_normals(per_face_corner=True)``)."""
@@ -435,7 +435,7 @@ def test_normals_on_the_hybrids_creases_are_the_tangent_masks(name):
         m = hybridsub.read_mesh(pathlib.Path(__file__).parent / "data" / "mesh_with_border.off")
         V, F = np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
         tags = dict(scheme="hybrid")
-    s, face, bary, ref = _on_crease_edges(tags, V, F)
+    s, face, bary, ref = split_edge_vertices(tags, V, F)
     pick = np.random.default_rng(0).permutation(len(face))[:400]
     face, bary, ref = face[pick], bary[pick], ref[pick]
     assert len(face) >= 200

@@ -6,8 +6,8 @@ There the chart has no derivative across the edge: the edge is halved every step
 it and the chart shears along it by an amount that does not settle as the edge is approached
 (the walk's ``Du``, ``Dv`` there grow with the depth, the along-edge one lost digits, and
 normals were up to 90° off). The values are exact at every such point, so the derivatives
-are taken from a one-sided quadratic fit of values at :data:`STEP` along the edge and into
-the face: six values per point, each a walk of its own, combined with fixed weights.
+are taken from a one-sided quadratic fit of values at one and two :data:`STEP` along the edge
+and into the face: the point's own value and four more walks, combined with fixed weights.
 ``docs/limit.md`` ("Points on a split edge") gives the accuracy against the vertices' tangent
 masks.
 """
@@ -19,20 +19,18 @@ import scipy.sparse as sp
 
 from .depth import PointDepths
 
-#: The fit's step in barycentric units (samples at one and two steps along and into the face).
+#: The fit's step in barycentric units.
 STEP = 1e-5
 #: Points within this of a corner are the corner's (their own rules, ``depth.py``).
 AT_CORNER = 1e-12
 
-# Offsets (along, into) of the six samples in steps, and the weights that give, from their
-# values, ∂σ, ∂ν, ∂σσ, ∂σν, ∂νν of the quadratic through them (σ along, ν into; per step).
-_OFFSETS = np.array([[0, 0], [1, 0], [2, 0], [0, 1], [0, 2], [1, 1]], float)
+# Offsets (along, into) of the samples in steps after the point itself, and the weights that
+# give ∂σ, ∂ν (σ along, ν into; per step) from the values at the point and the samples: the
+# one-sided second-order differences of the quadratic through them.
+_OFFSETS = np.array([[1, 0], [2, 0], [0, 1], [0, 2]], float)
 _FIT = np.array([
-    [-1.5, 2.0, -0.5, 0.0, 0.0, 0.0],  # ∂σ (one-sided, second order)
-    [-1.5, 0.0, 0.0, 2.0, -0.5, 0.0],  # ∂ν
-    [1.0, -2.0, 1.0, 0.0, 0.0, 0.0],  # ∂σσ
-    [1.0, -1.0, 0.0, -1.0, 0.0, 1.0],  # ∂σν
-    [1.0, 0.0, 0.0, -2.0, 1.0, 0.0],  # ∂νν
+    [-1.5, 2.0, -0.5, 0.0, 0.0],
+    [-1.5, 0.0, 0.0, 2.0, -0.5],
 ])
 
 
@@ -50,8 +48,8 @@ def on_split_edge(depths: PointDepths, f: np.ndarray, b: np.ndarray) -> tuple[np
 
 
 def samples(b: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The fit's sample points (6, q, 3) of the edge points ``b`` (zero coordinate ``k``), and
-    the weights (5, 6, q) that turn their values into ``Du, Dv, Duu, Duv, Dvv``.
+    """The fit's samples (4, q, 3) of the edge points ``b`` (zero coordinate ``k``), and the
+    weights (2, 5, q) that turn the values at the points and their samples into ``Du, Dv``.
 
     Into the face is towards corner ``k`` from the edge's farther end (its coordinate ≥ ½),
     along the edge away from it, so every sample stays in the face."""
@@ -66,26 +64,17 @@ def samples(b: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     into[rows, k], into[rows, far] = 1.0, -1.0
     pts = b[None] + STEP * (_OFFSETS[:, :1, None] * along[None] + _OFFSETS[:, 1:, None] * into[None])
     pts[:, rows, far] = 1.0 - pts[:, rows, near] - pts[:, rows, k]  # each sums to 1 exactly
-    # (σ, ν) → (u, v) = (b1, b2): J rows are the directions' (u, v) per step.
+    # (σ, ν) → (u, v) = (b1, b2): J's rows are the two directions' (u, v) per step.
     J = STEP * np.stack([along[:, 1:], into[:, 1:]], axis=1)  # (q, 2, 2)
-    Ji = np.linalg.inv(J)
-    first = np.einsum("qab,bj->qaj", Ji, _FIT[:2])  # (q, 2, 6): Du, Dv
-    Q = np.stack([np.stack([_FIT[2], _FIT[3]], 0), np.stack([_FIT[3], _FIT[4]], 0)], 0)  # (2, 2, 6)
-    H = np.einsum("qab,bcj,qdc->qadj", Ji, Q, Ji)  # (q, 2, 2, 6): J⁻¹ Q J⁻ᵀ
-    W = np.stack([first[:, 0], first[:, 1], H[:, 0, 0], H[:, 0, 1], H[:, 1, 1]], 0)  # (5, q, 6)
-    return pts, np.ascontiguousarray(W.transpose(0, 2, 1))
+    W = np.einsum("qab,bj->ajq", np.linalg.inv(J), _FIT)  # (2, 5, q): Du, Dv
+    return pts, np.ascontiguousarray(W)
 
 
-def combine(W: np.ndarray, values: np.ndarray, n_rows: int) -> np.ndarray:
-    """``Du, Dv`` (and with ``n_rows`` 6 the second derivatives) (n_rows − 1, q, d) from the
-    samples' values (6, q, d) and :func:`samples`' weights."""
-    return np.einsum("rjq,jqd->rqd", W[:n_rows - 1], values)
+def combine(W: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """``Du, Dv`` (2, q, d) from the values (5, q, d) at the points and their samples."""
+    return np.einsum("rjq,jqd->rqd", W, values)
 
 
-def combine_rows(W: np.ndarray, rows: list, n_rows: int) -> list:
-    """As :func:`combine` for the samples' value rows (six CSR matrices (q, n))."""
-    out = []
-    for r in range(n_rows - 1):
-        M = sum(sp.diags(W[r, j]) @ rows[j] for j in range(6))
-        out.append(sp.csr_matrix(M))
-    return out
+def combine_rows(W: np.ndarray, rows: list) -> list:
+    """As :func:`combine` for value rows: five CSR matrices (q, n), the points' and their samples'."""
+    return [sp.csr_matrix(sum(sp.diags(W[r, j]) @ rows[j] for j in range(len(rows)))) for r in range(2)]

@@ -263,8 +263,9 @@ class LimitSurface:
         idx, k = on_split_edge(self._depths, f, b) if derivatives else (np.zeros(0, np.int64), None)
         if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
             pts, W = samples(b[idx], k)
-            vals = self._matrix(np.tile(f[idx], 6), pts.reshape(-1, 3), False, depth)
-            new = combine_rows(W, [vals[j * len(idx):(j + 1) * len(idx)] for j in range(6)], 3)
+            vals = self._matrix(np.tile(f[idx], len(pts)), pts.reshape(-1, 3), False, depth)
+            q = len(idx)
+            new = combine_rows(W, [mats[0][idx]] + [vals[j * q:(j + 1) * q] for j in range(len(pts))])
             keep = np.ones(len(f))
             keep[idx] = 0.0
             put = sp.csr_matrix((np.ones(len(idx)), (idx, np.arange(len(idx)))), shape=(len(f), len(idx)))
@@ -317,8 +318,8 @@ class LimitSurface:
         idx, k = on_split_edge(self._depths, f, b) if n_rows == 3 else (np.zeros(0, np.int64), None)
         if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
             pts, W = samples(b[idx], k)
-            vals = self._applied(np.tile(f[idx], 6), pts.reshape(-1, 3), 1, depth, X2, rule_depth)[0]
-            res[1:, idx] = combine(W, vals.reshape(6, len(idx), -1), n_rows)
+            vals = self._applied(np.tile(f[idx], len(pts)), pts.reshape(-1, 3), 1, depth, X2, rule_depth)[0]
+            res[1:, idx] = combine(W, np.concatenate([res[:1, idx], vals.reshape(len(pts), len(idx), -1)]))
         return res
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
