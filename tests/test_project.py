@@ -101,6 +101,25 @@ def test_queries_the_many_trials_found(name, scheme, seed, i, why):
     assert_no_farther(s, Q[i:i + 1], Y[i:i + 1])
 
 
+@pytest.mark.parametrize("sign, n", [(1.0, 100), pytest.param(-1.0, 200, marks=pytest.mark.slow),
+                                     pytest.param(1.0, 400, marks=pytest.mark.slow)])
+def test_queries_off_the_hybrids_creases_come_back_to_them(sign, n):
+    """Queries pushed off fandisk's split creases (hybrid, 30°) along a sector normal by 1e-4
+    diagonals: their foot is the crease point. The walk's derivatives on a split edge beside a
+    √3 face mislead Newton along the wall (13 of 200 feet were up to 9e-9 diagonals farther);
+    the step uses the fitted ones (``edge_fit.py``). Oracle: the level-2 vertices on those
+    edges, their normals from the tangent masks."""
+    from test_limit_surface import split_edge_vertices
+
+    V, F = hybridsub.load_example()
+    feat = hybridsub.detect_features(V, F, angle=30)
+    tags = dict(scheme="hybrid", sharp_edges=feat.sharp_edges, corners=feat.corners)
+    s, face, bary, normal = split_edge_vertices(tags, V, F)
+    pick = np.random.default_rng(0).permutation(len(face))[:n]
+    Y = s.evaluate(face[pick], bary[pick])
+    assert_no_farther(s, Y + sign * 1e-4 * diagonal(s) * normal[pick], Y)
+
+
 @pytest.mark.parametrize("scheme", SCHEMES)
 @pytest.mark.parametrize("name", MESHES)
 def test_far_points_are_no_farther_than_any_sample(name, scheme):

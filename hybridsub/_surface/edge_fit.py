@@ -8,6 +8,8 @@ it and the chart shears along it by an amount that does not settle as the edge i
 normals were up to 90° off). The values are exact at every such point, so the derivatives
 are taken from a one-sided quadratic fit of values at one and two :data:`STEP` along the edge
 and into the face: the point's own value and four more walks, combined with fixed weights.
+``project``'s Newton steps take these first derivatives too (with the walk's own second ones):
+with the walk's, a run on the edge stepped along it to the wrong place.
 ``docs/limit.md`` ("Points on a split edge") gives the accuracy against the vertices' tangent
 masks.
 """
@@ -23,6 +25,9 @@ from .depth import PointDepths
 STEP = 1e-5
 #: Points within this of a corner are the corner's (their own rules, ``depth.py``).
 AT_CORNER = 1e-12
+#: A point whose least coordinate is below this (under one rounding unit of the other two) is
+#: on the edge for the walk too: its derivatives there are the edge's, and as broken.
+ON_EDGE = 1e-16
 
 # Offsets (along, into) of the samples in steps after the point itself, and the weights that
 # give ∂σ, ∂ν (σ along, ν into; per step) from the values at the point and the samples: the
@@ -41,7 +46,7 @@ def on_split_edge(depths: PointDepths, f: np.ndarray, b: np.ndarray) -> tuple[np
     if depths.sqrt3 or not depths.edge.any() or not len(f):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     k = np.argmin(b, axis=1)
-    on = (b[np.arange(len(f)), k] == 0) & (b.max(axis=1) < 1 - AT_CORNER)
+    on = (b[np.arange(len(f)), k] < ON_EDGE) & (b.max(axis=1) < 1 - AT_CORNER)
     on &= depths.edge[f, (k + 1) % 3]  # halfedge i (corner i to i + 1) is where b[(i + 2) % 3] = 0
     idx = np.flatnonzero(on)
     return idx, k[idx]

@@ -240,6 +240,8 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
     Pb = np.zeros((k, 3))
     trust = np.ones(k)
     active = np.ones(k, dtype=bool)
+    tried = np.ones(k)  # the fraction of its Newton step the row's last trial took
+    slope = np.full(k, np.nan)  # (d − best) / tried of the row's last rejected trial
     for _ in range(max_iter):
         idx = np.flatnonzero(active)
         if not len(idx):
@@ -261,6 +263,17 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
         Pb[ib] = P[better]
         trust[ib] = 1.0
         trust[idx[~better]] *= 0.25
+        # Rejected trials lie on one ray from the best point. Two of them give the distance's
+        # slope there (its quadratic through them): where it rises at first order (a foot at a
+        # corner, or on a wall whose derivatives mislead the step), no shorter trial is nearer.
+        worse = idx[~better]
+        s_new = (d[~better] - best_d[worse]) / tried[worse]
+        s_old, t_old = slope[worse], 4.0 * tried[worse]
+        g = s_new - (s_old - s_new) * tried[worse] / (t_old - tried[worse])
+        rising = (s_new > 0) & (s_old > 0) & (g > 0.5 * s_new) & (d[~better] - best_d[worse] > 1e-12 * best_d[worse])
+        active[worse[rising]] = False
+        slope[ib] = np.nan
+        slope[worse] = s_new
         du, dv = _newton_step(best_f[idx], best_b[idx], walls, cone[F0[best_f[idx]]], R[idx],
                               *(G[idx, j] for j in range(5)))
         size = np.hypot(du, dv)
@@ -272,6 +285,7 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
         bb = best_b[idx]
         cut = np.where(wall & (delta < 0), bb / np.where(delta < 0, -delta, 1.0), 1.0).min(axis=1)
         nb = bb + delta * np.minimum(cut, 1.0)[:, None]
+        tried[idx] = scale * np.minimum(cut, 1.0)
         face[idx], bary[idx] = onto_input_faces(best_f[idx], nb, walls, F0)
         active[idx[((reach < stop) & better) | level]] = False
         active[idx[trust[idx] < 1e-12]] = False

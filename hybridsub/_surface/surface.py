@@ -315,11 +315,11 @@ class LimitSurface:
         parts = self._chunks(f, b, lambda fc, bc: walk_points(self._table, self._starts, fc, bc, n_rows,
                                                               self._depths(fc, bc, depth, rule_depth), X2))
         res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
-        idx, k = on_split_edge(self._depths, f, b) if n_rows == 3 else (np.zeros(0, np.int64), None)
+        idx, k = on_split_edge(self._depths, f, b) if n_rows >= 3 else (np.zeros(0, np.int64), None)
         if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
             pts, W = samples(b[idx], k)
             vals = self._applied(np.tile(f[idx], len(pts)), pts.reshape(-1, 3), 1, depth, X2, rule_depth)[0]
-            res[1:, idx] = combine(W, np.concatenate([res[:1, idx], vals.reshape(len(pts), len(idx), -1)]))
+            res[1:3, idx] = combine(W, np.concatenate([res[:1, idx], vals.reshape(len(pts), len(idx), -1)]))
         return res
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
