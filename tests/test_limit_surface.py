@@ -495,8 +495,7 @@ def test_points_on_creases_are_the_crease_curve(scheme, mesh):
     """Oracle: on a crease edge between two crease vertices the limit is the cubic B-spline of the
     crease polygon (its rules see only crease vertices), a computation that shares nothing with
     the walk. At the default depth, random edge parameters: values to 1e-12 × diagonal, the
-    derivative along the edge to its accuracy (Loop: the walk's, 1e-11; hybrid: the edge fit's,
-    ``edge_fit.py``)."""
+    derivative along the edge (Loop: the walk's; hybrid: the curve's, ``edge_fit.py``)."""
     if mesh == "fandisk":
         V, F = hybridsub.load_example()
     else:
@@ -515,4 +514,6 @@ def test_points_on_creases_are_the_crease_curve(scheme, mesh):
     # d/dt along corner i → i + 1, with (u, v) = (b1, b2): i = 0: Du; 1: Dv − Du; 2: −Dv
     Dt = np.where((i == 0)[:, None], Du, np.where((i == 1)[:, None], Dv - Du, -Dv))
     err = np.linalg.norm(Dt - D, axis=1).max() / np.linalg.norm(D, axis=1).max()
-    assert err < (1e-10 if scheme == "loop" else 1e-5), err  # hybrid: up to 3.4e-6 (the fit's step, 1e-5)
+    # hybrid: the curve's own derivative, with the rounding of the fit across the edge mixed in
+    # through (u, v) (up to 2.5e-9; the fit along the edge gave 3.4e-6)
+    assert err < (1e-10 if scheme == "loop" else 1e-8), err

@@ -14,7 +14,7 @@ from .._input import as_vertices, open_gate, writable
 from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme
 from .cache import PatchTable
 from .depth import PointDepths
-from .edge_fit import combine, combine_rows, on_split_edge, samples
+from .edge_fit import combine, combine_rows, crease_polygons, curve_along, on_crease_curve, on_split_edge, samples
 from .project import closest_points, seed_setup
 from .walk import StartKeys, walk_points, walk_rows
 
@@ -135,6 +135,7 @@ class LimitSurface:
         self.depth = int(depth) + (int(depth) % 2 if scheme == "sqrt3" else 0)  # Kobbelt: even levels
         self._tol, self._max_levels = 1e-12, 60
         self._depths = PointDepths(self._inp, _default_depth(scheme))
+        self._polygons = crease_polygons(self._inp)
         self._new_cache()
 
     @property
@@ -262,10 +263,17 @@ class LimitSurface:
         mats = [a[0] if len(a) == 1 else sp.csr_matrix(sp.vstack(a)) if a else sp.csr_matrix((0, n)) for a in parts]
         idx, k = on_split_edge(self._depths, f, b) if derivatives else (np.zeros(0, np.int64), None)
         if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
-            pts, W = samples(b[idx], k)
-            vals = self._matrix(np.tile(f[idx], len(pts)), pts.reshape(-1, 3), False, depth)
+            curve = on_crease_curve(self._polygons, f[idx], k)
+            pts, W, A = samples(b[idx], k, curve)
+            walked = self._walked_samples(curve, len(pts))
             q = len(idx)
+            pick = sp.csr_matrix((np.ones(len(walked)), (walked, np.arange(len(walked)))), shape=(len(pts) * q, len(walked)))
+            vals = pick @ self._matrix(np.tile(f[idx], len(pts))[walked], pts.reshape(-1, 3)[walked], False, depth)
             new = combine_rows(W, [mats[0][idx]] + [vals[j * q:(j + 1) * q] for j in range(len(pts))])
+            if curve.any():
+                cw, cc = curve_along(self._polygons, f[idx[curve]], b[idx[curve]], k[curve])
+                R = sp.csr_matrix((cw.ravel(), (np.repeat(np.flatnonzero(curve), 4), cc.ravel())), shape=(q, n))
+                new = [sp.csr_matrix(D + sp.diags(A[r]) @ R) for r, D in enumerate(new)]
             keep = np.ones(len(f))
             keep[idx] = 0.0
             put = sp.csr_matrix((np.ones(len(idx)), (idx, np.arange(len(idx)))), shape=(len(f), len(idx)))
@@ -317,10 +325,27 @@ class LimitSurface:
         res = np.concatenate(parts, axis=1) if parts else np.zeros((n_rows, 0, X2.shape[1]))
         idx, k = on_split_edge(self._depths, f, b) if n_rows >= 3 else (np.zeros(0, np.int64), None)
         if len(idx):  # no derivative across the edge in the chart: a fit of exact values (edge_fit.py)
-            pts, W = samples(b[idx], k)
-            vals = self._applied(np.tile(f[idx], len(pts)), pts.reshape(-1, 3), 1, depth, X2, rule_depth)[0]
-            res[1:3, idx] = combine(W, np.concatenate([res[:1, idx], vals.reshape(len(pts), len(idx), -1)]))
+            curve = on_crease_curve(self._polygons, f[idx], k)
+            pts, W, A = samples(b[idx], k, curve)
+            walked = self._walked_samples(curve, len(pts))
+            vals = np.zeros((len(pts) * len(idx), X2.shape[1]))
+            if len(walked):
+                vals[walked] = self._applied(np.tile(f[idx], len(pts))[walked], pts.reshape(-1, 3)[walked], 1, depth,
+                                             X2, rule_depth)[0]
+            D = combine(W, np.concatenate([res[:1, idx], vals.reshape(len(pts), len(idx), -1)]))
+            if curve.any():
+                cw, cc = curve_along(self._polygons, f[idx[curve]], b[idx[curve]], k[curve])
+                D[:, curve] += A[:, curve, None] * np.einsum("cj,cjd->cd", cw, X2[cc])[None]
+            res[1:3, idx] = D
         return res
+
+    @staticmethod
+    def _walked_samples(curve: np.ndarray, n_samples: int) -> np.ndarray:
+        """Indices into the fit's (n_samples × q) samples that need a walk: not the two along
+        a crease curve, whose derivative there is the curve's (``edge_fit.py``)."""
+        need = np.ones((n_samples, len(curve)), bool)
+        need[:2, curve] = False
+        return np.flatnonzero(need.ravel())
 
     def normals(self, face: ArrayLike, bary: ArrayLike, *, vertices: ArrayLike | None = None) -> np.ndarray:
         """Unit normals ``∂P/∂u × ∂P/∂v`` (k, 3) (one-sided at creases: the given face's side).
