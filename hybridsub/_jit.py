@@ -105,16 +105,22 @@ def _probe_function():
 class _CompileNotice(numba.core.event.Listener):
     """Says once per process, on stderr, that hybridsub's kernels are being compiled: the
     first call after an install (or after an edit of the sources) waits for it, and a
-    silent wait of many seconds reads as a hang. ``HYBRIDSUB_COMPILE_NOTICE=0`` silences it."""
+    silent wait of many seconds reads as a hang. ``HYBRIDSUB_COMPILE_NOTICE=0`` silences it.
+    Each such compile also lets :mod:`hybridsub._compile_ahead` start (or switch) the helpers
+    that compile the rest of the call's kernels ahead."""
 
     said = False
 
     def on_start(self, event):
-        if _CompileNotice.said:
-            return
         dispatcher = event.data.get("dispatcher")
         module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
         if not module.startswith("hybridsub."):
+            return
+        try:  # by name, not a ``from . import``: a kernel's cache stamp follows this module's imports
+            importlib.import_module("hybridsub._compile_ahead").on_compile()
+        except Exception:  # noqa: BLE001 - compiling ahead only saves time: never a failed call
+            pass
+        if _CompileNotice.said:
             return
         _CompileNotice.said = True
         if os.environ.get("HYBRIDSUB_COMPILE_NOTICE", "1") == "0":

@@ -5,6 +5,8 @@ missing library fails there instead of skipping."""
 import importlib.util
 import os
 
+os.environ["HYBRIDSUB_COMPILE_AHEAD"] = "0"  # no helpers compiling ahead (_compile_ahead.py)
+
 collect_ignore = []
 if os.environ.get("HYBRIDSUB_REQUIRE_ADAPTERS") != "1":
     collect_ignore += [f"{name}.py" for name in ("torch", "jax")

@@ -12,6 +12,9 @@ settings.register_profile("repeatable", derandomize=True, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile("explore" if os.environ.get("HYBRIDSUB_EXPLORE") == "1" else "repeatable")
 
+# No helpers compiling ahead (hybridsub/_compile_ahead.py): the tests that want them say so.
+os.environ["HYBRIDSUB_COMPILE_AHEAD"] = "0"
+
 DATA = os.path.join(os.path.dirname(__file__), "data")
 sys.path.insert(0, os.path.dirname(__file__))
 

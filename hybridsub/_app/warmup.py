@@ -164,9 +164,11 @@ JOBS: list[tuple[str, Callable[[], None]]] = [
 
 def warm_up(quiet: bool = False) -> float:
     """Run every job of :data:`JOBS`; returns the seconds taken. Progress on stderr."""
+    from .. import _compile_ahead
     from .._jit import _CompileNotice
 
     _CompileNotice.said = True  # compiling is what was asked for: no notice
+    _compile_ahead.switch_off()  # and all of it: no helper for one job
     start = time.perf_counter()
     for what, job in JOBS:
         t = time.perf_counter()
