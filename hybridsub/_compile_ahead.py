@@ -288,6 +288,9 @@ def on_compile() -> None:
     env = dict(os.environ, HYBRIDSUB_COMPILE_AHEAD="0", HYBRIDSUB_COMPILE_NOTICE="0")
     if numba.config.CACHE_DIR:
         env["NUMBA_CACHE_DIR"] = numba.config.CACHE_DIR
+    # this copy of hybridsub first, wherever the caller's sys.path found it (a source checkout)
+    home = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env["PYTHONPATH"] = os.pathsep.join([home] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     for i in range(n):
         try:
             _helpers.append(subprocess.Popen(
