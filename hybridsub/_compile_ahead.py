@@ -10,7 +10,7 @@ processes (``python -m hybridsub._compile_ahead JOB PARENT_PID I N``) that compi
 job's list from its end, into the same on-disk cache; a later compile under another entry
 point (``detect_features`` first, then ``LimitSurface``) ends them and starts that job's.
 The call walks the list from the start; what a helper has written by the time the call
-reaches it is loaded, not compiled. On two cores, cold first calls take 10–42 % less wall
+reaches it is loaded, not compiled. On two cores, cold first calls take 8–47 % less wall
 time (docs/performance.md, "First call").
 
 The results do not change: a kernel loaded from the cache is the one the call would have
