@@ -3,8 +3,8 @@
 Private. A first call on an empty kernel cache compiles each kernel as it reaches it, one
 after the other, on one core. The kernels a kind of call needs are known ahead: the lists in
 ``data/kernel_signatures.json``, one per job (``"limit surface/hybrid"``, ``"refine/loop"``,
-…), each kernel with the argument types it was compiled for, in the order a first call
-compiles them. On the first compile of a process, :func:`on_compile` names the job from
+…), each kernel with the argument types it was compiled for: first what only larger calls
+compile (the threaded twins), then the rest in the order a first call compiles them. On the first compile of a process, :func:`on_compile` names the job from
 the call stack (the outermost public entry point, its ``scheme`` and tags) and starts helper
 processes (``python -m hybridsub._compile_ahead JOB PARENT_PID I N``) that compile that
 job's list from its end, into the same on-disk cache; a later compile under another entry
@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import atexit
 import functools
+import importlib
 import json
 import multiprocessing
 import os
@@ -101,11 +102,26 @@ r = hybridsub.refine(F, E, levels=1, scheme=scheme, corners=C)
 hybridsub.fit(F, r.apply(V), E, corners=C, V0=V, scheme=scheme, levels=1, max_iterations=2)
 """,
 }
+#: What ``--record`` runs after the recipe: larger calls of the same kind, whose extra kernels
+#: (the threaded twins, from ``PARALLEL_MIN`` faces or points on) go first in the list, where
+#: the helpers, working from its end, reach them last: a small first call does not wait for them.
+LARGER = {
+    "subdivide": "hybridsub.subdivide(V, F, E, levels=3, scheme=scheme, corners=C)",
+    "refine": "hybridsub.refine(F, E, levels=3, scheme=scheme, corners=C).apply(V)",
+    "limit positions": """
+hybridsub.limit_positions(V, F, E, levels=2, scheme=scheme, corners=C)
+hybridsub.limit_normals(V, F, E, levels=2, scheme=scheme, corners=C)
+""",
+    "limit surface": """
+face, bary = rng.integers(0, len(F), 20000), rng.dirichlet(np.ones(3), 20000)
+s.evaluate(face, bary, derivatives=True)
+""",
+}
 #: ``"JOB/SCHEME"`` with creases and corners, ``"JOB/SCHEME untagged"`` without (√3: never tagged).
 VARIANTS = ("hybrid", "hybrid untagged", "loop", "loop untagged", "sqrt3")
 JOBS = tuple(f"{job}/{variant}" for job in RECIPES for variant in VARIANTS if job != "fit") + ("fit/hybrid",)
 
-#: Jobs a process starts helpers for at most (each later entry point may switch once).
+#: Jobs a process starts helpers for at most (the first, then switches to later entry points).
 MOST_JOBS = 8
 
 _helpers: list[subprocess.Popen] = []
@@ -132,10 +148,8 @@ def encode(args: Sequence[types.Type]) -> list | None:
 def _encode_one(t: types.Type):
     if isinstance(t, types.Array) and isinstance(t.dtype, (types.Integer, types.Float, types.Boolean)):
         return ["array", str(t.dtype), t.ndim, t.layout, not t.mutable]
-    if isinstance(t, (types.Integer, types.Float)):
-        return ["scalar", str(t)]
-    if isinstance(t, types.Boolean):
-        return ["scalar", "bool"]
+    if isinstance(t, (types.Integer, types.Float, types.Boolean)):
+        return ["scalar", str(t)]  # NumPy's names: int64, float32, bool
     if isinstance(t, types.NoneType):
         return ["none"]
     if isinstance(t, types.UniTuple):
@@ -169,8 +183,6 @@ def _decode_one(e) -> types.Type:
 
 def find_kernel(module: str, qualname: str):
     """The dispatcher of ``module`` whose Python function is ``qualname``, or None."""
-    import importlib
-
     try:
         mod = importlib.import_module(module)
     except ImportError:
@@ -385,8 +397,11 @@ def _record_child(job: str) -> None:
     else:
         feat = hybridsub.detect_features(V, F, angle=30)
         E, C = feat.sharp_edges, feat.corners
-    exec(RECIPES[name], {"hybridsub": hybridsub, "np": np, "V": V, "F": F, "E": E, "C": C, "scheme": scheme})
-    print(json.dumps(seen))
+    scope = {"hybridsub": hybridsub, "np": np, "V": V, "F": F, "E": E, "C": C, "scheme": scheme}
+    exec(RECIPES[name], scope)
+    first = len(seen)
+    exec(LARGER.get(name, ""), scope)
+    print(json.dumps(seen[first:] + seen[:first]))
 
 
 def record(path: str | None = None, jobs: Sequence[str] = JOBS) -> dict[str, list]:

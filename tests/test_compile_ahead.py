@@ -3,6 +3,7 @@ faithfully, the job is named from the call stack, and a helper's cache makes the
 compiled for load every kernel instead of compiling one (slow: fresh processes, empty caches)."""
 
 import json
+import multiprocessing
 import os
 import subprocess
 import sys
@@ -114,6 +115,22 @@ def test_switched_off(monkeypatch):
     assert ahead.helpers_wanted() == 0
     monkeypatch.setenv("HYBRIDSUB_COMPILE_AHEAD", "1")
     assert ahead.helpers_wanted() == max(0, min(len(os.sched_getaffinity(0)) - 1, ahead.MOST_HELPERS))
+    monkeypatch.setenv("NUMBA_DISABLE_JIT", "1")
+    assert ahead.helpers_wanted() == 0
+
+
+def _wanted_in_worker(out):
+    out.put(ahead.helpers_wanted())
+
+
+def test_no_helpers_in_multiprocessing_workers(monkeypatch):
+    monkeypatch.setenv("HYBRIDSUB_COMPILE_AHEAD", "1")
+    ctx = multiprocessing.get_context("fork")
+    out = ctx.Queue()
+    worker = ctx.Process(target=_wanted_in_worker, args=(out,))
+    worker.start()
+    assert out.get(timeout=60) == 0
+    worker.join(timeout=60)
 
 
 def test_a_stale_entry_is_skipped(tmp_path, monkeypatch):
@@ -127,9 +144,26 @@ def test_a_stale_entry_is_skipped(tmp_path, monkeypatch):
     assert ahead.load_lists(str(tmp_path / "missing.json")) == {}
 
 
+# What a user's first call looks like, written here (not the recipes the lists were recorded
+# from): other point counts and arguments than the recording's.
+_CALLS = {
+    "refine/loop": """
+feat = hybridsub.detect_features(V, F, angle=30)
+r = hybridsub.refine(F, feat.sharp_edges, levels=3, scheme="loop", corners=feat.corners)
+r.apply(V)
+""",
+    "limit surface/hybrid": """
+feat = hybridsub.detect_features(V, F, angle=30)
+s = hybridsub.LimitSurface(V, F, feat.sharp_edges, corners=feat.corners)
+s.evaluate(np.arange(100), np.full((100, 3), 1 / 3), derivatives=True)
+s.normals(np.arange(0, 3000, 7), np.tile([0.2, 0.3, 0.5], (429, 1)))
+""",
+    "adaptive/hybrid untagged": """
+hybridsub.subdivide_adaptive(V, F, tolerance="0.1%")
+""",
+}
 _CALL = """
-import numba, hybridsub
-from hybridsub._compile_ahead import RECIPES
+import numba, numpy as np, hybridsub
 misses = []
 class Count(numba.core.event.Listener):
     def on_start(self, event):
@@ -140,23 +174,19 @@ class Count(numba.core.event.Listener):
         pass
 numba.core.event.register("numba:compile", Count())
 V, F = hybridsub.load_example()
-feat = hybridsub.detect_features(V, F, angle=30)
-E, C = (None, None) if {untagged!r} else (feat.sharp_edges, feat.corners)
-exec(RECIPES[{name!r}], dict(hybridsub=hybridsub, np=__import__("numpy"), V=V, F=F, E=E, C=C, scheme={scheme!r}))
+{call}
 print("compiled:", misses)
 """
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("job", ["refine/loop", "limit surface/hybrid", "adaptive/hybrid untagged"])
+@pytest.mark.parametrize("job", sorted(_CALLS))
 def test_what_a_helper_compiled_the_call_loads(tmp_path, job):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), HYBRIDSUB_COMPILE_AHEAD="0")
     helper = subprocess.run([sys.executable, "-m", "hybridsub._compile_ahead", job, str(os.getpid()), "0", "1"],
                             env=env, capture_output=True, text=True, timeout=600)
     assert helper.returncode == 0, helper.stderr
-    name, variant = job.split("/")
-    call = subprocess.run([sys.executable, "-c", _CALL.format(name=name, scheme=variant.split()[0],
-                                                              untagged=variant.endswith("untagged"))], env=env,
+    call = subprocess.run([sys.executable, "-c", _CALL.format(call=_CALLS[job])], env=env,
                           capture_output=True, text=True, timeout=600)
     assert call.returncode == 0, call.stderr
     assert "compiled: []" in call.stdout, call.stdout  # every kernel loaded from the helper's cache
