@@ -4,10 +4,11 @@ Private. A first call on an empty kernel cache compiles each kernel as it reache
 after the other, on one core. The kernels a kind of call needs are known ahead: the lists in
 ``data/kernel_signatures.json``, one per job (``"limit surface/hybrid"``, ``"refine/loop"``,
 …), each kernel with the argument types it was compiled for: first what only larger calls
-compile (the threaded twins), then the rest in the order a first call compiles them. On the first compile of a process, :func:`on_compile` names the job from
-the call stack (the outermost public entry point, its ``scheme`` and tags) and starts helper
-processes (``python -m hybridsub._compile_ahead JOB PARENT_PID I N``) that compile that
-job's list from its end, into the same on-disk cache; a later compile under another entry
+compile (the threaded twins), then the rest in the order a first call compiles them. On the
+first compile of a process, :func:`on_compile` names the job from the call stack (the
+outermost public entry point, its ``scheme`` and tags) and starts helper processes
+(``python -m hybridsub._compile_ahead JOB PARENT_PID I N``) that compile that job's list from
+its end, into the same on-disk cache; a later compile under another entry
 point (``detect_features`` first, then ``LimitSurface``) ends them and starts that job's.
 The call walks the list from the start; what a helper has written by the time the call
 reaches it is loaded, not compiled. On two cores, cold first calls take 8–47 % less wall
