@@ -2,8 +2,9 @@
 
 usage: python benchmarks/cache_history.py [--points N] [--meshes M ...] [--schemes S ...]
 
-A key's representative is the first patch met with it (docs/limit.md, "The patch cache"), and
-patches of one key differ in shape by rounding. So N random points are evaluated with
+A key's representative is the first patch met with it (docs/limit.md, "The patch cache");
+patches of one key are the same tagged mesh with the same shapes, so the answers should not
+move. N random points are evaluated with
 derivatives on a fresh surface and on one that has answered N other points first; printed per
 mesh and scheme: the share of points whose bits differ, the largest position difference (in
 bounding-box diagonals) and the largest relative difference of ``Du``, ``Dv``. Creases at 30°

@@ -74,10 +74,10 @@ def test_cached_walk_equals_the_direct_descent(name):
 
 @pytest.mark.parametrize("name", list(CASES))
 def test_a_shared_cache_gives_what_a_fresh_one_gives(name):
-    """At the default depth. A key's representative is the first patch met with it, and patches of
-    one key differ in shape by rounding, so the history changes the last bits: values by
-    rounding, derivatives (whose rows grow like the inverse of the last face) by more. Loop's
-    shapes repeat exactly (midpoints of the chart's equilateral faces), so its bits do not move."""
+    """At the default depth, to the bit. A key's representative is the first patch met with
+    it; patches of one key are the same tagged mesh with the same shapes (every face
+    equilateral in the chart, taken exactly whichever corner it was entered at), so the
+    history does not move a bit."""
     V, F, kw = CASES[name]
     face, bary = _points(F, 40, seed=1)
     warm = hybridsub.LimitSurface(V, F, **kw)
@@ -87,10 +87,8 @@ def test_a_shared_cache_gives_what_a_fresh_one_gives(name):
     new = hybridsub.LimitSurface(V, F, **kw)
     fresh = new.evaluate(face, bary, derivatives=True)
     assert warm._table.n_keys - n_before < new._table.n_keys  # some keys were found again
-    for a, b, tol in zip(got, fresh, (1e-14, 1e-9, 1e-9)):
-        if kw.get("scheme") == "loop":
-            assert np.array_equal(a, b)
-        assert np.abs(a - b).max() <= tol * np.abs(b).max()
+    for a, b in zip(got, fresh):
+        assert np.array_equal(a, b)
     again = warm.evaluate(face, bary, derivatives=True)  # every key known: same bits
     for a, b in zip(got, again):
         assert np.array_equal(a, b)
@@ -147,9 +145,9 @@ class _NothingShared(dict):
         return default
 
 
-@pytest.mark.parametrize("name, shared", [("hybrid-crease", 0.5), ("loop-semisharp", 1.0)])
+@pytest.mark.parametrize("name, shared", [("hybrid-crease", 0.9), ("loop-semisharp", 1.0)])
 def test_transitions_are_stored_once_per_content(name, shared):
-    """Patches that differ in shape alone share their step's rows: the table holds each
+    """Keys of other connectivity often have the same step rows: the table holds each
     distinct transition once, and only what candidates point at; and the surface is the one
     of a table that shares nothing, to the bit (semi-sharp creases: rows of one pattern with
     other weights, which must not be shared)."""
@@ -170,35 +168,8 @@ def test_transitions_are_stored_once_per_content(name, shared):
     used = int((t.t_end.a[live][at] - first).sum())
     assert len(t.t_val.a) == used  # nothing stored that no candidate points at
     n_cands = int(live.sum())
-    assert len(stored) < shared * n_cands  # candidates share their rows (most of them on the hybrid)
+    assert len(stored) < shared * n_cands  # candidates share their rows
     assert len(t.t_val.a) < shared * len(plain._table.t_val.a)
-
-
-@pytest.mark.parametrize("name", ["hybrid-crease", "hybrid-boundary"])  # Loop's and √3's keys repeat outright here
-def test_keys_from_recipes_give_the_bits_of_refining_them(name, monkeypatch):
-    """Keys of a class met before take its recipes instead of being refined (candidate maps,
-    child patches, transitions): the surface and its rows are those of a table that keeps no
-    recipe, to the bit, and recipes were used."""
-    V, F, kw = CASES[name]
-    face, bary = _points(F, 300, seed=12)
-    with monkeypatch.context() as m:
-        m.setattr(C, "LEARN", 1 << 40)  # no class ever has that many keys: every key refined
-        plain = hybridsub.LimitSurface(V, F, depth=10, **kw)
-        ref = plain.evaluate(face, bary, derivatives=True)
-        ref_rows = plain.evaluation_matrix(face[:50], bary[:50], derivatives=True)
-    assert not (plain._table.cls_cand.a >= 0).any()
-    used = []
-    clone = C.PatchTable._clone_children
-    monkeypatch.setattr(C.PatchTable, "_clone_children", lambda self, c, *a: used.append(len(c)) or clone(self, c, *a))
-    s = hybridsub.LimitSurface(V, F, depth=10, **kw)
-    got = s.evaluate(face, bary, derivatives=True)
-    rows = s.evaluation_matrix(face[:50], bary[:50], derivatives=True)
-    assert sum(used) > 0 and (s._table.cls_cand.a >= 0).any()
-    for a, b in zip(got, ref):
-        assert np.array_equal(a, b)
-    for a, b in zip(rows, ref_rows):
-        assert (a != b).nnz == 0
-    assert s._table.n_keys == plain._table.n_keys
 
 
 def _torus(n=6, seed=6):
@@ -392,16 +363,17 @@ def test_small_index_arrays_widen_when_a_piece_needs_more():
 
 
 def test_chunks_keep_the_cache_near_its_cap_within_a_call(monkeypatch):
-    """Points whose keys rarely repeat (the hybrid beside creases) go in chunks sized by the
-    cache's growth per point, so one call holds the cache near ``CACHE_BYTES`` (it was one chunk
-    of up to 20000 points, 630 MB on a small CAD part)."""
+    """Points that would take the cache past ``CACHE_BYTES`` go in chunks sized by the cache's
+    growth per point, so one call holds the cache near the cap (it was one chunk of up to
+    20000 points, 630 MB on a small CAD part); here a cap of 1 MB against the 1.4 MB that
+    2000 points on the octahedron with a creased equator make."""
     import hybridsub._surface.surface as surface
 
     V, F = OCTA_V, OCTA_F
     kw = dict(sharp_edges=[[0, 2], [2, 1], [1, 3], [3, 0]])  # the equator
     face, bary = _points(F, 2000, seed=5)
     whole = hybridsub.LimitSurface(V, F, **kw).evaluate(face, bary, derivatives=True)
-    cap = 2**24
+    cap = 2**20
     monkeypatch.setattr(surface, "CACHE_BYTES", cap)
     monkeypatch.setattr(surface, "FIRST_CHUNK", 200)
     s = hybridsub.LimitSurface(V, F, **kw)

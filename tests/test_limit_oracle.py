@@ -3,8 +3,9 @@
 (a) uniform refinement and the limit masks at the refined vertices: ``evaluate`` at
     ``r.vertex_origin`` equals ``limit_positions(levels=L)`` at the default depth;
 (b) convergence at random parameters: the piecewise-linear interpolation of the level-k
-    limit positions, at the point's place in the level-k chart (followed with ``face_parent``
-    and the chart's barycentric maps, not the descent), tends to ``evaluate`` geometrically.
+    limit positions, at the point's place in the level-k chart (followed down with
+    ``face_parent`` and each child's corners in its parent's frame, not the descent), tends to
+    ``evaluate`` geometrically.
 """
 
 import os
@@ -14,7 +15,7 @@ import pytest
 
 import hybridsub
 from conftest import load_mesh
-from hybridsub._refiner.chart import EQUILATERAL, barycentric, child_shapes, matrix_supports
+from hybridsub._refiner.chart import FaceCharts
 from hybridsub._topology import build_level
 
 
@@ -142,41 +143,42 @@ def test_refined_vertices_are_their_limit_positions_everywhere(case):
     _check_vertices(*case, n_points=3000)
 
 
-def _face_corners(F0: np.ndarray, n0: int, r) -> tuple[np.ndarray, np.ndarray]:
-    """Every face of the last level of ``r``: its input face, and its corners' barycentric
-    coordinates over that face (unfolded across its edges where they lie outside), by the
-    chart's rules (old vertices stay, midpoints, centroids, Kobbelt's thirds), face by face
-    from its parent (``face_parent``)."""
-    F, n = F0, n0
-    shape = np.repeat(EQUILATERAL[None], len(F0), axis=0)
-    B = np.repeat(np.eye(3)[None], len(F0), axis=0)
-    root = np.arange(len(F0))
-    twin = build_level(F0, n0).twin
-    for st in r.steps:
-        ids, w = matrix_supports(st.matrix, n)
-        shape1 = child_shapes(F, twin, shape, st.faces, st.face_parent, ids, w)
-        B = barycentric(shape[st.face_parent][:, None], shape1) @ B[st.face_parent]
-        root = root[st.face_parent]
-        shape, F, n = shape1, st.faces, st.n_vertices
-        twin = build_level(F, n).twin
-    return root, B
-
-
-def _around(F: np.ndarray, f: int) -> dict:
-    """Input face ``f`` and its edge-neighbours: each one's corners (3, 2) in ``f``'s chart
-    frame (``f`` equilateral, a neighbour its mirror image across their edge)."""
-    out = {f: EQUILATERAL}
-    for i in range(3):
-        u, w, x = F[f, i], F[f, (i + 1) % 3], F[f, (i + 2) % 3]
-        for g in np.flatnonzero((F == u).any(axis=1) & (F == w).any(axis=1)):
-            if g == f:
-                continue
-            a, b, c = EQUILATERAL[i], EQUILATERAL[(i + 1) % 3], EQUILATERAL[(i + 2) % 3]
-            d = b - a
-            far = 2 * (a + d * np.dot(c - a, d) / np.dot(d, d)) - c  # c mirrored across edge ab
-            pos = {u: a, w: b}
-            out[int(g)] = np.array([pos.get(v, far) for v in F[g]])
+def _into_frame(x: np.ndarray, f: int, i: int, t: int) -> np.ndarray:
+    """Barycentric coordinates ``x`` (..., 3) over the face across halfedge ``3f + i`` (its
+    twin ``t``), in ``f``'s frame: there corner ``t % 3`` is our corner i + 1, the next our
+    corner i, the third our corner i + 2 mirrored across the edge."""
+    a = t % 3
+    out = np.zeros(x.shape)
+    out[..., (i + 1) % 3] += x[..., a] + x[..., (a + 2) % 3]
+    out[..., i] += x[..., (a + 1) % 3] + x[..., (a + 2) % 3]
+    out[..., (i + 2) % 3] -= x[..., (a + 2) % 3]
     return out
+
+
+def _charts(F0: np.ndarray, n0: int, r) -> FaceCharts:
+    charts = FaceCharts(F0, n0, lambda F, n: build_level(F, n).twin)
+    for st in r.steps:
+        charts.step(st)
+    return charts
+
+
+def _locate(charts: FaceCharts, face: int, bary: np.ndarray) -> tuple[int, np.ndarray]:
+    """The face of the last level of ``charts`` that holds the point (``face``, ``bary``) of the
+    input, and the point's barycentric coordinates there, followed down level by level with
+    ``face_parent`` and the chart's rule (every face equilateral in its own frame, its
+    edge-neighbours mirrored onto it; each child's corners in its parent's frame from
+    :class:`FaceCharts`), among the children of the point's face and of its neighbours."""
+    f, b = face, np.asarray(bary, dtype=np.float64)
+    for lam, parent, twin in charts.levels:
+        best, best_lo, best_b = -1, -np.inf, None
+        for g, i in [(f, -1)] + [(int(twin[3 * f + i]) // 3, i) for i in range(3) if twin[3 * f + i] >= 0]:
+            for c in np.flatnonzero(parent == g):
+                corners = lam[c] if i < 0 else _into_frame(lam[c], f, i, int(twin[3 * f + i]))
+                x = np.linalg.solve(corners.T, b)  # the point over the child's corners
+                if x.min() > best_lo:
+                    best, best_lo, best_b = int(c), float(x.min()), x
+        f, b = best, best_b
+    return f, b
 
 
 @pytest.mark.parametrize("scheme, tags, levels", [
@@ -201,16 +203,12 @@ def test_refinement_converges_to_the_surface_at_random_parameters(scheme, tags, 
     for k in levels:
         r = hybridsub.refine(F, levels=k, **kw)
         L = hybridsub.limit_positions(V, F, levels=k, **kw)
-        root, B = _face_corners(F, len(V), r)
         gap = 0.0
+        charts = _charts(F, len(V), r)
         for f, b, p in zip(face, bary, P):
-            frames = _around(F, f)  # input faces f and its neighbours, their corners in f's frame
-            mine = np.flatnonzero(np.isin(root, list(frames)))
-            corners = np.stack([B[i] @ frames[root[i]] for i in mine])  # (k, 3, 2) in f's frame
-            lam = barycentric(corners, np.broadcast_to(b @ EQUILATERAL, (len(mine), 2)))
-            j = np.argmax(lam.min(axis=1))
-            assert lam[j].min() > -1e-9  # a face of the level holds the point
-            gap = max(gap, float(np.linalg.norm(lam[j] @ L[r.faces[mine[j]]] - p)))
+            c, lam = _locate(charts, int(f), b)
+            assert lam.min() > -1e-9  # a face of the level holds the point
+            gap = max(gap, float(np.linalg.norm(lam @ L[r.faces[c]] - p)))
         gaps.append(gap)
     gaps = np.array(gaps) / _diag(V)
     rate = (gaps[-1] / gaps[0]) ** (1 / (levels[-1] - levels[0]))
@@ -219,13 +217,11 @@ def test_refinement_converges_to_the_surface_at_random_parameters(scheme, tags, 
 
 @pytest.mark.parametrize("name, scheme, levels", [("icosahedron", "sqrt3", 6), ("tetrahedron", "hybrid", 5)])
 def test_both_faces_of_an_edge_put_its_midpoint_on_one_surface_point(name, scheme, levels):
-    """The charts that follow each face of a refinement onto the input (``FaceCharts``, which
+    """The charts that carry each face of a refinement onto the input (``FaceCharts``, which
     adaptive refinement measures its error through): an edge's midpoint, taken through either
-    of its two faces, is one point of the limit surface. √3's flips move faces round a vertex
-    level by level; a face left in the chart it started in ends up across the vertex, where
-    the way back onto an input face is not unique round a vertex whose faces do not add up to
-    a plane (the icosahedron's valence 5: the two sides then named points 6 % of the diagonal
-    apart)."""
+    of its two faces, is one point of the limit surface, also where √3's flips have moved
+    faces round a vertex of valence 5 (an earlier chart, which carried each face in the chart
+    of the input face it started in, named points 6 % of the diagonal apart there)."""
     from hybridsub._refiner.chart import FaceCharts
 
     V, F = load_mesh(name)

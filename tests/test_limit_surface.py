@@ -515,5 +515,5 @@ def test_points_on_creases_are_the_crease_curve(scheme, mesh):
     Dt = np.where((i == 0)[:, None], Du, np.where((i == 1)[:, None], Dv - Du, -Dv))
     err = np.linalg.norm(Dt - D, axis=1).max() / np.linalg.norm(D, axis=1).max()
     # hybrid: the curve's own derivative, with the rounding of the fit across the edge mixed in
-    # through (u, v) (up to 2.5e-9; the fit along the edge gave 3.4e-6)
+    # through (u, v) (up to 1.5e-9)
     assert err < (1e-10 if scheme == "loop" else 1e-8), err

@@ -1,12 +1,15 @@
 """The parameter chart: where every refined vertex lies over the input.
 
-Every input face is an equilateral triangle of the chart, and the two faces of an edge form a
-rhombus. A step keeps the old vertices where they are, puts edge points at the midpoints of
-their edges (Kobbelt's boundary trisection points at the thirds), face points at the centroids
-of their faces. The chart is flat away from the input vertices, so the shape of each refined
-face — its three corners in a 2-D frame of its own — is all a step needs: a child face's
-corners are found in its parent's frame, those of a neighbour face's points after gluing the
-neighbour onto the parent along their shared edge (a rigid motion of the chart).
+Every face of every level is an equilateral triangle of a frame of its own, and the two faces
+of an edge form a rhombus there (each the other's mirror image). A step keeps the old vertices
+where they are, puts edge points at the midpoints of their edges (Kobbelt's boundary
+trisection points at the thirds), face points at the centroids of their faces, all in the
+parent face's frame: a child face's corners are found there, those of a neighbour face's
+points after gluing the neighbour onto the parent along their shared edge (a rigid motion).
+So a child's place in its parent depends on the connectivity and tags alone, never on the
+shapes of the levels above: the limit surface's patches repeat wherever their connectivity
+does (``docs/limit.md``). The map from a face to the input is piecewise affine (a point of a
+child that straddles two parents is carried through the parent it lies in).
 
 >>> import numpy as np
 >>> F = np.array([[0, 1, 2], [2, 1, 3]]); shape = np.repeat(EQUILATERAL[None], 2, axis=0)
@@ -187,118 +190,73 @@ def onto_input_faces(face: np.ndarray, bary: np.ndarray, twin0: np.ndarray, F0: 
 
 
 class FaceCharts:
-    """Each face's corners over the input, followed step by step: ``inface`` (m,) the input
-    face whose unfolded chart holds the face, ``B`` (m, 3, 3) its corners' barycentric
-    coordinates there (negative across an edge of that face).
+    """Where points of a refined level lie over the input, followed step by step.
 
-    ``step(st)`` follows one :class:`RefinementStep` (faces, matrix, face_parent);
-    :meth:`points` puts points given over a face onto input faces.
+    Every face of every level is an equilateral triangle of its own frame, its edge-neighbours
+    glued on as mirror images (the rhombus of two faces), so a step's children have fixed
+    places in their parent's frame: a child corner is a chart combination (midpoint,
+    Kobbelt's third, centroid) of the parent's corners or of a neighbour's, the neighbour's
+    far corner being the parent's corner mirrored across their edge. ``step(st)`` follows one
+    :class:`RefinementStep` (faces, matrix, face_parent) and keeps each child's corners in its
+    parent's frame; :meth:`points` carries points given over the last level's faces up, one
+    level at a time, across an edge where a point lies in its parent's neighbour, onto the
+    input faces.
     """
 
     def __init__(self, F0: np.ndarray, n0: int, twin_of):
         self.F0, self.F, self.n = F0, F0, n0
         self.twin_of = twin_of
-        self.shape = np.repeat(EQUILATERAL[None], len(F0), axis=0)
-        self.B = np.repeat(np.eye(3)[None], len(F0), axis=0)
-        self.inface = np.arange(len(F0))
         self.twin0 = twin_of(F0, n0)
         self.twin = self.twin0
+        self.levels = []  # per step: each child's corners in its parent's frame (m', 3, 3), the parents, their twins
 
     def step(self, st) -> None:
         ids, w = matrix_supports(st.matrix, self.n)
         parent = st.face_parent
-        shape1 = child_shapes(self.F, self.twin, self.shape, st.faces, parent, ids, w)
-        lam = barycentric(self.shape[parent][:, None], shape1)
-        self.B = lam @ self.B[parent]
-        self.inface = self.inface[parent]
-        self.shape, self.F, self.n = shape1, st.faces, st.n_vertices
+        shape = np.broadcast_to(EQUILATERAL, (len(self.F), 3, 2))
+        lam = barycentric(EQUILATERAL, child_shapes(self.F, self.twin, shape, st.faces, parent, ids, w))
+        self.levels.append((lam, np.asarray(parent, dtype=np.int64), self.twin))
+        self.F, self.n = st.faces, st.n_vertices
         self.twin = self.twin_of(self.F, self.n)
-        self._rehome()
-
-    def _rehome(self, tol: float = 1e-12) -> None:
-        """Faces whose centroid has left their input face across one edge move to the chart of
-        the input face across it. Faces drift round a vertex level by level (√3's flips); left
-        in the chart they started in, they would end up across the vertex, where the way back
-        onto an input face is not unique (a vertex whose faces do not add up to a plane)."""
-        for _ in range(8):
-            c = self.B.mean(axis=1)
-            j = np.argmin(c, axis=1)
-            r = np.arange(len(c))
-            cj = c[r, j]
-            others = np.sort(c, axis=1)[:, 1]
-            move = np.flatnonzero((cj < -tol) & (others >= -tol))
-            if not len(move):
-                return
-            t = self.twin0[3 * self.inface[move] + (j[move] + 1) % 3]
-            ok = t >= 0
-            move, t = move[ok], t[ok]
-            if not len(move):
-                return
-            jj, a = j[move][:, None], (t % 3)[:, None]
-            b = self.B[move]  # (k, 3 corners, 3)
-            k3 = np.arange(3)[None, :]
-            bj = np.take_along_axis(b, np.broadcast_to(jj[:, None], (len(move), 3, 1)), axis=2)[..., 0]
-            bj1 = np.take_along_axis(b, np.broadcast_to(((jj + 1) % 3)[:, None], (len(move), 3, 1)), axis=2)[..., 0]
-            bj2 = np.take_along_axis(b, np.broadcast_to(((jj + 2) % 3)[:, None], (len(move), 3, 1)), axis=2)[..., 0]
-            nb = np.empty_like(b)
-            rows = np.arange(len(move))[:, None]
-            for col, val in ((a, bj2 + bj), ((a + 1) % 3, bj1 + bj), ((a + 2) % 3, -bj)):
-                nb[rows, k3, np.broadcast_to(col, (len(move), 3))] = val
-            self.B[move] = nb
-            self.inface[move] = t // 3
 
     def points(self, faces: np.ndarray, bary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points ``bary`` (k, 3) over the current faces ``faces`` (k,) as (input face, bary)."""
-        b = np.einsum("ki,kij->kj", bary, self.B[faces])
-        return onto_input_faces(self.inface[faces], b, self.twin0, self.F0)
+        f, b = np.asarray(faces, dtype=np.int64), np.asarray(bary, dtype=np.float64)
+        for lam, parent, twin in reversed(self.levels):
+            b = np.einsum("ki,kij->kj", b, lam[f])
+            f, b = onto_input_faces(parent[f], b, twin, None)
+        return f, b
 
-
-def best_held_corners(F: np.ndarray, B: np.ndarray, n: int) -> np.ndarray:
-    """For each of ``n`` vertices, the corner (flat index into ``F``) whose chart ``B`` (m, 3,
-    3) holds it least unfolded: across the fewest edges of its face's input face, then on the
-    fewest of their lines, then the least far, then the first; −1 for a vertex no face uses.
-    A corner with two negative coordinates lies across a vertex of its input face, and round a
-    vertex whose faces do not add up to a plane the way across it is not unique."""
-    flat = F.ravel()
-    first = np.full(n, -1, np.int64)
-    if len(flat):
-        Bc = B.reshape(-1, 3)
-        across = (Bc < -1e-9).sum(axis=1)
-        on_line = (np.abs(Bc) <= 1e-9).sum(axis=1)
-        outside = np.round(np.minimum(Bc, 0.0).sum(axis=1), 9)
-        corner = np.arange(len(flat))
-        order = np.lexsort((corner, -outside, on_line, across, flat))  # by vertex, the best-held first
-        lead = np.ones(len(order), bool)
-        lead[1:] = flat[order[1:]] != flat[order[:-1]]
-        first[flat[order[lead]]] = order[lead]
-    return first
+    def vertices(self, faces: np.ndarray, n: int, only: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(face, bary) over the input of each of the current level's ``n`` vertices (or of
+        the vertices ``only``), through the first of the faces ``faces`` that uses it (face −1,
+        bary (1, 0, 0) where none does)."""
+        face = np.full(n, -1, np.int64)
+        bary = np.zeros((n, 3))
+        bary[:, 0] = 1.0
+        flat = (3 * np.asarray(faces, dtype=np.int64)[:, None] + np.arange(3)).ravel()
+        used, first = np.unique(self.F.ravel()[flat], return_index=True)
+        last = np.full(n, -1, np.int64)
+        last[used] = flat[first]  # the first corner of each vertex
+        if only is not None:
+            last = last[only]
+            face, bary = face[:len(last)], bary[:len(last)]
+        used = np.flatnonzero(last >= 0)
+        if len(used):
+            face[used], bary[used] = self.points(last[used] // 3, np.eye(3)[last[used] % 3])
+        return face, bary
 
 
 def vertex_origins(F0: np.ndarray, n0: int, steps, twin_of) -> tuple[np.ndarray, np.ndarray]:
     """(face, bary) of every vertex of the last of ``steps`` over the input faces ``F0``.
 
     ``steps`` are :class:`RefinementStep` objects (faces, matrix, face_parent); ``twin_of(F, n)``
-    gives a level's halfedge twins. Each vertex is reported through the face of the finest
-    level that uses it whose chart holds it least unfolded (across the fewest edges of that
-    face's input face, then on the fewest of their lines, then the least far; the first such
-    face in face order): a corner
-    with two negative coordinates lies across a vertex of its input face, and round a vertex
-    whose faces do not add up to a plane the way across it is not unique, while a face that
-    holds the vertex within one edge of its input face names the one the refinement put it
-    in. A vertex no face uses gets face −1 and bary (1, 0, 0).
+    gives a level's halfedge twins. Each vertex is carried up from the first face of the last
+    level that uses it (:meth:`FaceCharts.points`); one on an input edge or at an input vertex
+    is reported over one of the input faces there. A vertex no face uses gets face −1 and
+    bary (1, 0, 0).
     """
     charts = FaceCharts(F0, n0, twin_of)
     for st in steps:
         charts.step(st)
-    F, n, B, inface, twin0 = charts.F, charts.n, charts.B, charts.inface, charts.twin0
-    flat = F.ravel()
-    first = best_held_corners(F, B, n)
-    face = np.full(n, -1, np.int64)
-    bary = np.zeros((n, 3))
-    bary[:, 0] = 1.0
-    used = first >= 0
-    face[used] = inface[first[used] // 3]
-    bary[used] = B[first[used] // 3, first[used] % 3]
-    if used.any():
-        face[used], bary[used] = onto_input_faces(face[used], bary[used], twin0, F0)
-    return face, bary
+    return charts.vertices(np.arange(len(charts.F)), charts.n)

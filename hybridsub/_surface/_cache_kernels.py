@@ -12,6 +12,9 @@ import numpy as np
 
 from .._jit import kernel
 
+#: The height of the unit equilateral triangle.
+HALF_SQRT3 = math.sqrt(3.0) / 2
+
 
 @kernel
 def canonical_order(F, twin, n, fstart, centre, fperm, vperm, vstart, entry):
@@ -111,19 +114,17 @@ def _normalise(shape, f, s0, s, grid, r, out, norm):
     norm[r, 1, 1] = 0.0
     norm[r, 2, 0] = (co * dx + si * dy) / s
     norm[r, 2, 1] = (co * dy - si * dx) / s
+    # The chart's faces are equilateral: taken as the exact triangle whichever corner they
+    # were entered at (the rotation's rounding would make a key's representative depend on
+    # the first patch met).
+    near = abs(norm[r, 1, 0] - 1.0) + abs(norm[r, 2, 0] - 0.5) + abs(norm[r, 2, 1] - HALF_SQRT3)
+    if near < 1e-12:
+        norm[r, 1, 0] = 1.0
+        norm[r, 2, 0] = 0.5
+        norm[r, 2, 1] = HALF_SQRT3
     out[r, 10] = round(norm[r, 1, 0] / grid)
     out[r, 11] = round(norm[r, 2, 0] / grid)
     out[r, 12] = round(norm[r, 2, 1] / grid)
-
-
-@kernel
-def shape_records(shape, fstart, scale, grid, out, norm):
-    """:func:`face_records`' shape part for faces already in canonical order, their corners
-    from the one they were entered at: ``out[:, 10:13]`` and ``norm`` of piece ``i``'s faces
-    ``fstart[i]:fstart[i + 1]``, scaled by ``1 / scale[i]``."""
-    for i in range(len(fstart) - 1):
-        for r in range(fstart[i], fstart[i + 1]):
-            _normalise(shape, r, 0, scale[i], grid, r, out, norm)
 
 
 @kernel(inline="always")
@@ -333,27 +334,6 @@ def transition_hashes(row, col, vbits, bounds, out):
 
 
 @kernel
-def support_codes(verts, off, ids, w, table, sup, code):
-    """The chart supports ``ids``, ``w`` (n', 3) of the vertices ``verts`` over their piece's
-    own vertices (``off``: the piece's first): ``sup`` (k, 3) (−1: unused) and ``code``
-    (k, 3) the weights' places in ``table``. Returns False if a weight is not there."""
-    for i in range(len(verts)):
-        v = verts[i]
-        for s in range(3):
-            x = ids[v, s]
-            sup[i, s] = x - off[i] if x >= 0 else -1
-            c = -1
-            for j in range(len(table)):
-                if w[v, s] == table[j]:
-                    c = j
-                    break
-            if c < 0:
-                return False
-            code[i, s] = c
-    return True
-
-
-@kernel
 def gather_pieces(keys, f0, nf, rep_f, rep_twin, rep_shape, foff, voff, faces, twin, shape):
     """The representatives of ``keys`` (faces ``f0[k]:f0[k] + nf[k]`` of the stored corners
     ``rep_f``, twins ``rep_twin`` and shapes ``rep_shape``, see :class:`.cache.PatchTable`)
@@ -407,56 +387,3 @@ def representative_rows(new, rec, fstart, norm, fs, cv, vstart, faces, twin, sha
         for v in range(vstart[p], vstart[p + 1]):
             corner[u] = cv[v]
             u += 1
-
-
-@kernel
-def clone_rows(ck, at, f0, v0, foff, voff, cf_parent, cv_sup, cv_w, weights, rep_f0, rep_nf, rep_v0, nv, rep_f,
-               rep_twin, rep_fs, rep_h0, rep_hbits, rep_corner, corners, parent, sup, w, rec, fs, cv):
-    """The inputs of ``child_shapes`` and the records of child patches made from recipes
-    (:meth:`.cache.PatchTable._clone_children`): piece ``i`` is the recipe's child key
-    ``ck[i]`` (its faces' parents from ``f0[i]`` in ``cf_parent``, its vertices' supports
-    from ``v0[i]`` in ``cv_sup``, ``cv_w``) over the owner's piece ``at[i]`` (faces from
-    ``foff``, vertices from ``voff``). Fills ``corners`` (m, 3) rows of ``sup``, ``w``
-    (n, 3), ``parent`` (m,), and the key's ``rec`` (m, 13: all but the shapes), sharp faces
-    ``fs`` and corner tags ``cv``."""
-    g = 0
-    u = 0
-    for i in range(len(ck)):
-        k = ck[i]
-        fo, vo = foff[at[i]], voff[at[i]]
-        a, h0 = rep_f0[k], rep_h0[k]
-        for r in range(rep_nf[k]):
-            for c in range(3):
-                x = rep_f[a + r, c]
-                corners[g, c] = x + u
-                rec[g, c] = x
-                rec[g, 3 + c] = rep_twin[a + r, c]
-                rec[g, 7 + c] = rep_hbits[h0 + r, c] if h0 >= 0 else 0
-            rec[g, 6] = 1 if rep_fs[a + r] else 0
-            fs[g] = rep_fs[a + r]
-            parent[g] = cf_parent[f0[i] + r] + fo
-            g += 1
-        b = rep_v0[k]
-        for j in range(nv[k]):
-            for s in range(3):
-                x = cv_sup[v0[i] + j, s]
-                sup[u, s] = x + vo if x >= 0 else -1
-                w[u, s] = weights[cv_w[v0[i] + j, s]]
-            cv[u] = rep_corner[b + j]
-            u += 1
-
-
-@kernel
-def candidate_rows(kk, at, foff, voff, ct_parent, ct_sup, ct_w, weights, parent, sup, w):
-    """The inputs of ``child_shapes`` for candidates made from their class's recipe
-    (:meth:`.cache.PatchTable._clone_steps`): candidate ``i`` is recipe row ``at[i]`` over
-    piece ``kk[i]`` (faces from ``foff``, vertices from ``voff``). Fills ``parent`` (q,),
-    ``sup``, ``w`` (3q, 3): the supports of its corners, one row each."""
-    for i in range(len(at)):
-        fo, vo = foff[kk[i]], voff[kk[i]]
-        parent[i] = ct_parent[at[i]] + fo
-        for c in range(3):
-            for s in range(3):
-                x = ct_sup[at[i], c, s]
-                sup[3 * i + c, s] = x + vo if x >= 0 else -1
-                w[3 * i + c, s] = weights[ct_w[at[i], c, s]]

@@ -16,7 +16,6 @@ import numpy as np
 
 from .._input import RefineInput, as_vertices, open_gate
 from .._refiner import FaceCharts, Refinement, refine, without_holes
-from .._refiner.chart import best_held_corners
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
@@ -113,9 +112,8 @@ class Criterion:
 
     def _limits(self, mesh: AdaptiveMesh, faces: np.ndarray, vertices: np.ndarray) -> None:
         """Limit positions of ``vertices``, placed through the charts of ``faces`` (each vertex
-        through the one that holds it least unfolded, as ``vertex_origin`` does)."""
-        at = best_held_corners(mesh.faces[faces], self.charts.B[faces], mesh.n_vertices)[vertices]
-        f, b = self.charts.points(faces[at // 3], np.eye(3)[at % 3])
+        through the first of them that uses it)."""
+        f, b = self.charts.vertices(faces, mesh.n_vertices, vertices)
         self.Q[vertices] = self.surface.evaluate(f, b)
         self.known[vertices] = True
 

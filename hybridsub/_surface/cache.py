@@ -2,12 +2,12 @@
 
 Below the first levels the patches of the descent (:mod:`.descent`) repeat: regular √3 and
 Loop neighbourhoods, crease and boundary sectors, the neighbourhood of an extraordinary
-vertex, each level's shapes the same up to a rigid motion and a scale. A patch is described
-by a *key*: its faces and vertices in a canonical order (breadth first from the centre face,
-entered at its corner 0, each face's corners from the one it was entered at), their
-connectivity, tags and shapes (each face's corners moved by a rigid motion of its own, the
-whole patch scaled by the centre face's first edge, rounded to :data:`GRID`), and Kobbelt's
-step parity for ``"sqrt3"``. Two patches with one key are the same tagged mesh up to the
+vertex. A patch is described by a *key*: its faces and vertices in a canonical order
+(breadth first from the centre face, entered at its corner 0, each face's corners from the
+one it was entered at), their connectivity, tags and shapes (each face's corners moved by a
+rigid motion of its own, the whole patch scaled by the centre face's first edge, rounded to
+:data:`GRID`: every face is equilateral in the chart, so the shapes only confirm it), and
+Kobbelt's step parity for ``"sqrt3"``. Two patches with one key are the same tagged mesh up to the
 numbering of their vertices, so one of them, the key's *representative*, stands for all: it
 is refined once with the project's own step (``descent.step``'s machinery) and what the
 walk needs is kept in flat tables:
@@ -16,20 +16,13 @@ walk needs is kept in flat tables:
   map ``M`` of the point's barycentric coordinates into the child's (its inverse transposed
   holds the child's corners over the centre face, to follow (u, v)) and, once a point has
   chosen it, the child's key and the step's rows restricted to (child patch × patch)
-  vertices ``T`` (stored once per distinct content: they depend on the connectivity and tags
-  alone, so keys that differ in shape share them);
+  vertices ``T`` (stored once per distinct content: keys of other connectivity often have
+  the same rows);
 - per key ending a descent, the interpolation stencil's six vertices with their exact limit
   rows over the patch (``descent.limit_rows``), and the stencil's per-patch data.
 
-Keys that differ in shape alone form a *class* (the key without its shapes). The step's
-plan, rows and child connectivity are the class's, and so are the parent faces and chart
-supports that place every child corner (``child_shapes``): from a class's second key on,
-those are kept as *recipes*, and a key of a known class is not refined: its candidate maps
-and its children's shapes come from its own shapes through the recipes
-(:meth:`PatchTable._clone_steps`, :meth:`PatchTable._clone_children`).
-
 Everything is exact by construction: the tables hold the existing code's results on the
-representatives (the recipes' by the same operations on the same numbers).
+representatives.
 """
 
 from __future__ import annotations
@@ -37,22 +30,17 @@ from __future__ import annotations
 import numpy as np
 
 from .._topology import Level
-from .._refiner import barycentric, child_shapes, glue_maps
+from .._refiner import barycentric
 from ._cache_kernels import (
-    candidate_rows,
     canonical_order,
-    clone_rows,
     face_records,
     gather_pieces,
     key_hashes,
     regular_flags,
     representative_rows,
-    shape_records,
-    support_codes,
     transition_hashes,
 )
 from .descent import (
-    MAX_CHILDREN,
     Patches,
     cut_children,
     limit_rows,
@@ -62,14 +50,8 @@ from .descent import (
 
 #: Shapes in a key are rounded to this (relative to the centre face's first edge).
 GRID = 1e-9
-#: A key's candidate slots: its centre face's children and those of its three neighbours.
-SLOTS = 4 * MAX_CHILDREN
-#: The chart's support weights (:func:`.._refiner.plan_supports`), stored in recipes by code.
-WEIGHTS = np.array([0.0, 1.0, 0.5, 1.0 / 3.0, 2.0 / 3.0])
 #: Refined steps kept for cutting their candidates' children later.
 KEPT = 4
-#: Recipes are kept for classes of more keys than this.
-LEARN = 1
 
 
 class Grow:
@@ -139,19 +121,6 @@ def canonicalise(level: Level, corner: np.ndarray, shape: np.ndarray, centre: np
     return fperm, vperm, vstart, rec, norm, entry
 
 
-def _local_supports(sh, verts: np.ndarray, off: np.ndarray):
-    """The chart supports of a step's vertices ``verts`` (``sh``: :class:`.descent.ChildShapes`)
-    over their piece's own vertices (``off``: its first, one per vertex): ids (k, 3) (−1:
-    unused) and the weights' codes into :data:`WEIGHTS` (None where one is not among them)."""
-    verts = np.ascontiguousarray(verts, dtype=np.int64).ravel()
-    sup = np.empty((len(verts), 3), np.int64)
-    code = np.empty((len(verts), 3), np.uint8)
-    off = np.ascontiguousarray(np.broadcast_to(off, verts.shape), dtype=np.int64)
-    if not support_codes(verts, off, sh.ids, sh.w, WEIGHTS, sup, code):
-        return sup, None  # pragma: no cover - the chart's supports have these weights
-    return sup, code
-
-
 class PatchTable:
     """Keys, representatives and the transition tables of one scheme (see the module doc)."""
 
@@ -205,36 +174,12 @@ class PatchTable:
         self._kept = []  # the last steps refined (:meth:`_refine`), for cutting their children
         self._order = []  # the keys last given steps, by parity: the order children are registered in
         self._t_index: dict[tuple, int] = {}  # a transition's contents (hashed) → its first entry
-        # Classes: keys without their shapes (connectivity, tags, parity). Per key its class;
-        # per class where its candidates' recipe starts (SLOTS rows: whether a candidate,
-        # its parent face, its corners' chart supports over the patch, their weights' codes)
-        # and per slot its cut's recipe (−1: none yet): the child key, its transition (first
-        # and end entry, hash), where its faces' rows (parent) and vertices' rows (supports,
-        # weights' codes) start.
-        self._class_index: dict[tuple, int] = {}
-        self.key_class = Grow((), np.int64)
-        self.cls_cand = Grow((), np.int64, -1)
-        self.cls_cut = Grow((SLOTS,), np.int64, -1)
-        self.ct_valid = Grow((), np.bool_)
-        self.ct_parent = Grow((), np.int16)
-        self.ct_sup = Grow((3, 3), np.int16)
-        self.ct_w = Grow((3, 3), np.uint8)
-        self.cut_child = Grow((), np.int64)
-        self.cut_t = Grow((2,), np.int64)
-        self.cut_tkey = Grow((2,), np.uint64)
-        self.cut_f0 = Grow((), np.int64)
-        self.cut_v0 = Grow((), np.int64)
-        self.cf_parent = Grow((), np.int16)
-        self.cv_sup = Grow((3,), np.int16)
-        self.cv_w = Grow((3,), np.uint8)
-        self.cls_keys = Grow((), np.int32)  # per class: its keys so far (recipes are kept from two on)
-
     @property
     def nbytes(self) -> int:
-        """What the cache holds: its arrays' capacity (they grow by half), its three
+        """What the cache holds: its arrays' capacity (they grow by half), its two
         dictionaries estimated."""
         grown = sum(g.capacity_bytes for g in vars(self).values() if isinstance(g, Grow))
-        return grown + 120 * (len(self.index) + len(self._t_index) + len(self._class_index))
+        return grown + 120 * (len(self.index) + len(self._t_index))
 
     @property
     def n_keys(self) -> int:
@@ -301,8 +246,7 @@ class PatchTable:
 
     def _add_representatives(self, new, rec, fstart, fs, cv, vstart, norm, parity):
         """The pieces ``new`` of a batch (:meth:`_keys_of`'s arrays) become the representatives
-        of the next keys, in order (:func:`._cache_kernels.representative_rows`); each key's
-        connectivity class is found (or made)."""
+        of the next keys, in order (:func:`._cache_kernels.representative_rows`)."""
         nf = fstart[new + 1] - fstart[new]
         nv = vstart[new + 1] - vstart[new]
         m, k = int(nf.sum()), len(new)
@@ -324,21 +268,6 @@ class PatchTable:
         self.rep_shape.append(shape3)
         self.rep_corner.append(cvn)
         self.nv.append(nv)
-        # The class: the key without its shapes (connectivity, tags, parity).
-        hc = np.empty((len(new), 2), np.uint64)
-        key_hashes(crec, np.append(f0, m), self._bits(cvn), np.append(v0, len(cvn)), parity, hc)
-        cls = np.empty(len(new), np.int64)
-        for i, key in enumerate(zip(hc[:, 0].tolist(), hc[:, 1].tolist())):
-            c = self._class_index.get(key)
-            if c is None:
-                c = self._class_index[key] = len(self._class_index)
-            cls[i] = c
-        self.key_class.append(cls)
-        self.cls_cand.extend_to(len(self._class_index))
-        self.cls_cut.extend_to(len(self._class_index))
-        self.cls_keys.extend_to(len(self._class_index))
-        np.add.at(self.cls_keys.a, cls, 1)
-
     def regular_keys(self, keys: np.ndarray) -> np.ndarray:
         """Whether each key is a regular Loop patch (:func:`.regular.is_regular`)."""
         return self.regular.a[keys] == 1
@@ -393,25 +322,17 @@ class PatchTable:
         return out
 
     def fill_steps(self, keys: np.ndarray):
-        """The candidates of ``keys`` (unique, not refined yet): their maps ``M``. Keys of a
-        class met before take its candidates' recipe (:meth:`_clone_steps`), the others are
-        refined. The candidates are numbered by parity, then key, whichever way they are
-        made (the order :meth:`fill_children` is given them in)."""
+        """The candidates of ``keys`` (unique, not refined yet): their maps ``M``, numbered by
+        parity, then key (the order :meth:`fill_children` is given them in)."""
         par = self.parity.a[keys]
         self._order = [keys[par == b] for b in np.unique(par)]
-        rows = self.cls_cand.a[self.key_class.a[keys]]
-        known = rows >= 0
         parts = []
-        if known.any():
-            parts.append((keys[known], *self._clone_steps(keys[known], rows[known])))
-        if not known.all():
-            for r in self._refined(keys[~known]):
-                X = r["p"].shape[r["p"].face]  # (k, 3, 2)
-                cid, cc = r["cid"], r["ccorn"]
-                valid = cid >= 0
-                kk, jj = np.nonzero(valid)
-                parts.append((r["keys"], valid, np.swapaxes(barycentric(cc[kk, jj][:, None], X[kk]), 1, 2)))
-                self._learn_steps(r)
+        for r in self._refined(keys):
+            X = r["p"].shape[r["p"].face]  # (k, 3, 2)
+            cid, cc = r["cid"], r["ccorn"]
+            valid = cid >= 0
+            kk, jj = np.nonzero(valid)
+            parts.append((r["keys"], valid, np.swapaxes(barycentric(cc[kk, jj][:, None], X[kk]), 1, 2)))
         got, valid, M = (np.concatenate(x) for x in zip(*parts))
         order = np.concatenate(self._order)
         perm = _position(got, order)
@@ -431,65 +352,11 @@ class PatchTable:
         self.cand_start.a[keys] = start + np.concatenate([[0], np.cumsum(cnt)[:-1]])
         self.cand_count.a[keys] = cnt
 
-    def _learn_steps(self, r):
-        """The candidates' recipe of each class first refined in ``r`` (:meth:`_refine`): per
-        slot, whether there is a candidate, its parent face and the chart supports of its
-        corners over the patch."""
-        keys = r["keys"]
-        cls = self.key_class.a[keys]
-        need = np.flatnonzero((self.cls_cand.a[cls] < 0) & (self.cls_keys.a[cls] > LEARN))
-        if not len(need):
-            return
-        u, first = np.unique(cls[need], return_index=True)
-        sel = need[first]
-        sh = r["shapes_of"]
-        cid = r["cid"][sel]  # (m, 24)
-        valid = cid >= 0
-        c = np.maximum(cid, 0)
-        parent = np.where(valid, sh.parent[c] - r["foff"][sel][:, None], 0)
-        off = np.repeat(r["voff"][sel], 3 * SLOTS)
-        sup, code = _local_supports(sh, sh.faces1[c], off)
-        if code is None:  # pragma: no cover - the step's supports are these weights
-            return
-        sup, code = sup.reshape(-1, SLOTS, 3, 3), code.reshape(-1, SLOTS, 3, 3)
-        sup[~valid] = -1
-        code[~valid] = 0
-        base = self.ct_valid.append(valid.ravel())
-        self.ct_parent.append(parent.ravel())
-        self.ct_sup.append(sup.reshape(-1, 3, 3))
-        self.ct_w.append(code.reshape(-1, 3, 3))
-        self.cls_cand.a[u] = base + SLOTS * np.arange(len(u))
-
-    def _clone_steps(self, keys, rows):
-        """:meth:`fill_steps` for keys whose class's candidates are known (``rows``: where its
-        recipe starts): which candidates (k, 24) and their maps, the corners from the key's
-        own shapes by the same operations as :func:`.descent.refine_patches`
-        (``child_shapes``, the glue maps), so the same maps to the bit, without refining the
-        patch."""
-        F, tw, shape, foff, voff = self._pieces(keys)
-        slots = rows[:, None] + np.arange(SLOTS)
-        valid = self.ct_valid.a[slots]
-        kk, jj = np.nonzero(valid)
-        at = slots[kk, jj]
-        n = len(at)
-        parent, sup, w = np.empty(n, np.int64), np.empty((3 * n, 3), np.int64), np.empty((3 * n, 3))
-        candidate_rows(kk, at, foff, voff, self.ct_parent.a, self.ct_sup.a, self.ct_w.a, WEIGHTS, parent, sup, w)
-        corners = child_shapes(F, tw, shape, np.arange(3 * n).reshape(n, 3), parent, sup, w)
-        _, R, t = glue_maps(shape, tw, foff[:-1])
-        k = len(keys)
-        Rg = np.concatenate([np.broadcast_to(np.eye(2), (k, 1, 2, 2)), R], axis=1)[kk, jj // MAX_CHILDREN]
-        tg = np.concatenate([np.zeros((k, 1, 2)), t], axis=1)[kk, jj // MAX_CHILDREN]
-        cc = Rg[:, None, :, 0] * corners[..., :1] + Rg[:, None, :, 1] * corners[..., 1:]
-        cc += tg[:, None, :]
-        X = shape[foff[:-1]]
-        return valid, np.swapaxes(barycentric(cc[:, None], X[kk]), 1, 2)
-
     def fill_children(self, cands: np.ndarray):
-        """Cut the child patches of the candidates ``cands`` (unique): their keys and ``T``.
-        A candidate whose slot was cut for a key of its owner's class before takes that
-        recipe (:meth:`_clone_children`); the others are cut from their owner's step.
+        """Cut the child patches of the candidates ``cands`` (unique) from their owners' steps
+        (refined again where no longer kept): their keys and ``T``.
 
-        The pieces are registered in one order whichever way they are made: those whose
+        The pieces are registered in one order whichever step they are cut from: those whose
         owner was among the last keys given steps (:meth:`fill_steps`, by parity), then the
         others by parity (the order of refining them all again). A key's representative
         is the first piece met with that key, so the order is part of the result."""
@@ -504,34 +371,29 @@ class PatchTable:
         if rest.any():
             self._order = [np.unique(owners[rest & (par == b)]) for b in np.unique(par[rest])]
             groups += [np.flatnonzero(rest & (par == b)) for b in np.unique(par[rest])]
-        tid = self.cls_cut.a[self.key_class.a[owners], self.slot.a[cands]]
-        cut = tid < 0
+        cut = np.ones(len(cands), bool)
         pool = list(self._kept)
         have = np.concatenate([r["keys"] for r in pool] + [np.zeros(0, np.int64)])
-        lack = cut & ~np.isin(owners, have)
-        if lack.any():  # keys refined at an earlier level or call, or taken from their class: refined (again)
+        lack = ~np.isin(owners, have)
+        if lack.any():  # keys refined at an earlier level or call: refined again
             pool += self._refined(np.unique(owners[lack]))
         for idx in groups:
             parts, finish = [], []
-            known = idx[~cut[idx]]
-            if len(known):
-                parts.append(self._clone_children(cands[known], owners[known], tid[known]))
-                finish.append((self._finish_clones, known, (cands[known], tid[known])))
             for r in pool[::-1]:  # the latest refining of an owner
                 i = idx[cut[idx] & np.isin(owners[idx], r["keys"])]
                 if len(i):
                     cut[i] = False
                     piece, more = self._cut_children(r, cands[i], owners[i])
                     parts.append(piece)
-                    finish.append((self._finish_cuts, i, more))
-            where = np.concatenate([f[1] for f in finish])
+                    finish.append((i, more))
+            where = np.concatenate([f[0] for f in finish])
             order = np.argsort(where)  # the pieces back in the order of idx (increasing)
             parity = int(par[idx[0]]) ^ 1 if self.scheme == "sqrt3" else 0
             kids = self._keys_of(*_pieces_in_order(parts, order), parity)
             at = np.empty(len(cands), np.int64)
             at[where[order]] = np.arange(len(where))
-            for fn, i, more in finish:
-                fn(kids[at[i]], *more)
+            for i, more in finish:
+                self._finish_cuts(kids[at[i]], *more)
 
     def _cut_children(self, r, cands, owners):
         """The child patches of ``cands`` cut from their owners' step ``r``: their pieces
@@ -541,9 +403,9 @@ class PatchTable:
         centre = r["cid"][node, self.slot.a[cands]]
         parent = r["shapes_of"].parent  # the refined faces by parent: a piece's are a range
         within = (np.searchsorted(parent, r["foff"][node]), np.searchsorted(parent, r["foff"][node + 1]))
-        nxt, corner_n, shape_n, cur, vsel, fstart, f1 = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
-                                                                     r["shapes_of"], centre, within)
-        fperm, vperm, vstart, rec, norm, entry, cv, reg = self._canonical(nxt, corner_n, shape_n, cur, fstart)
+        nxt, corner_n, shape_n, cur, vsel, fstart, _ = cut_children(r["p"], r["plan"], r["faces1"], r["child"],
+                                                                    r["shapes_of"], centre, within)
+        fperm, vperm, vstart, rec, norm, _, cv, reg = self._canonical(nxt, corner_n, shape_n, cur, fstart)
         T = r["S"][vsel[vperm]].tocoo()  # rows: the children's vertices in canonical order
         # Columns: the parent piece's vertices (canonical: the representative's own order).
         row_node = np.searchsorted(vstart, T.row, side="right") - 1
@@ -551,98 +413,20 @@ class PatchTable:
         row = T.row - vstart[row_node]
         bounds = np.searchsorted(row_node, np.arange(len(centre) + 1))
         piece = (rec, norm, nxt.face_sharp[fperm], cv, np.diff(fstart), np.diff(vstart), reg)
-        return piece, (r, cands, owners, node, fstart, fperm, vstart, vperm, vsel, f1, row.astype(np.int32),
-                       col.astype(np.int32), T.data, bounds)
+        return piece, (cands, row.astype(np.int32), col.astype(np.int32), T.data, bounds)
 
-    def _finish_cuts(self, kids, r, cands, owners, node, fstart, fperm, vstart, vperm, vsel, f1, row, col, val,
-                     bounds):
+    def _finish_cuts(self, kids, cands, row, col, val, bounds):
         """:meth:`_cut_children`'s candidates given their child keys ``kids``: their
-        transitions stored, their recipes learnt."""
-        tkeys = self._add_transitions(cands, row, col, val, bounds)
+        transitions stored."""
+        self._add_transitions(cands, row, col, val, bounds)
         self.child.a[cands] = kids
-        self._learn_children(r, cands, owners, node, kids, fstart, fperm, vstart, vperm, vsel, f1, tkeys)
-
-    def _learn_children(self, r, cands, owners, node, kids, fstart, fperm, vstart, vperm, vsel, f1, tkeys):
-        """The recipe of each (class, slot) first cut in :meth:`_cut_children` (classes of
-        more than one key): the child's key (its connectivity and tags are those of every
-        child cut there), its transition, per canonical child face its parent face, and per
-        canonical child vertex its chart supports."""
-        cls, slot = self.key_class.a[owners], self.slot.a[cands]
-        need = np.flatnonzero((self.cls_cut.a[cls, slot] < 0) & (self.cls_keys.a[cls] > LEARN))
-        if not len(need):
-            return
-        _, first = np.unique(cls[need] * SLOTS + slot[need], return_index=True)
-        sel = need[first]
-        nf, nv = fstart[sel + 1] - fstart[sel], vstart[sel + 1] - vstart[sel]
-        sh = r["shapes_of"]
-        fr = f1[fperm[_ranges(fstart[sel], nf)]]  # the canonical child faces' refined faces
-        vr = vsel[vperm[_ranges(vstart[sel], nv)]]  # the canonical child vertices' refined vertices
-        sup, code = _local_supports(sh, vr, np.repeat(r["voff"][node[sel]], nv))
-        if code is None:  # pragma: no cover - the step's supports are these weights
-            return
-        ids = self.cut_child.append(kids[sel]) + np.arange(len(sel))
-        self.cut_t.append(np.stack([self.t_start.a[cands[sel]], self.t_end.a[cands[sel]]], axis=1))
-        self.cut_tkey.append(tkeys[sel])
-        self.cut_f0.append(self.cf_parent.n + _firsts(nf))
-        self.cut_v0.append(self.cv_sup.n + _firsts(nv))
-        self.cf_parent.append(sh.parent[fr] - np.repeat(r["foff"][node[sel]], nf))
-        self.cv_sup.append(sup)
-        self.cv_w.append(code)
-        self.cls_cut.a[cls[sel], slot[sel]] = ids
-
-    def _clone_children(self, cands, owners, tid):
-        """The child patches of candidates whose (class, slot) was cut before (``tid``: its
-        recipe), as :func:`_pieces_in_order`'s parts: the recipe's child key's connectivity
-        and tags with shapes from the owner's own (``child_shapes``, then
-        :func:`._cache_kernels.face_records`' normalisation), the same to the bit as cutting
-        them (:meth:`_cut_children`), without refining or cutting."""
-        keys, inv = np.unique(owners, return_inverse=True)
-        F, tw, shape, foff, voff = self._pieces(keys)
-        ck = self.cut_child.a[tid]  # the recipes' child keys
-        nf, nv = self.rep_nf.a[ck], self.nv.a[ck]
-        n, nn = int(nf.sum()), int(nv.sum())
-        corners, parent = np.empty((n, 3), np.int64), np.empty(n, np.int64)
-        sup, w = np.empty((nn, 3), np.int64), np.empty((nn, 3))
-        rec, fs, cv = np.empty((n, 13), np.int64), np.empty(n, np.bool_), np.empty(nn, self.rep_corner.a.dtype)
-        hbits = self.rep_hs.a.view(np.int64) if self.rep_hs.n else np.zeros((1, 3), np.int64)
-        clone_rows(ck, inv, self.cut_f0.a[tid], self.cut_v0.a[tid], foff, voff, self.cf_parent.a, self.cv_sup.a,
-                   self.cv_w.a, WEIGHTS, self.rep_f0.a, self.rep_nf.a, self.rep_v0.a, self.nv.a, self.rep_F.a,
-                   self.rep_twin.a, self.rep_fs.a, self.rep_h0.a, hbits, self.rep_corner.a, corners, parent, sup, w,
-                   rec, fs, cv)
-        shp = child_shapes(F, tw, shape, corners, parent, sup, w)
-        fstart = np.concatenate([[0], np.cumsum(nf)])
-        sc = shp[fstart[:-1]]  # the centre faces: entered at corner 0
-        scale = np.hypot(sc[:, 1, 0] - sc[:, 0, 0], sc[:, 1, 1] - sc[:, 0, 1])
-        norm = np.empty((n, 3, 2))
-        shape_records(shp, fstart, scale, GRID, rec, norm)
-        return rec, norm, fs, cv, nf, nv, self.regular.a[ck]
-
-    def _finish_clones(self, kids, cands, tid):
-        """:meth:`_clone_children`' candidates given their child keys ``kids``: their
-        transitions are their recipes'."""
-        self.child.a[cands] = kids
-        t0, t1 = self.cut_t.a[tid, 0], self.cut_t.a[tid, 1]
-        start = np.empty(len(cands), np.int64)
-        for i, key in enumerate(zip(self.cut_tkey.a[tid, 0].tolist(), self.cut_tkey.a[tid, 1].tolist())):
-            got = self._t_index.get(key)
-            if got is None:  # not shared (an index that never finds one): stored anew
-                got = self._t_index[key] = self.t_row.n
-                a, b = int(t0[i]), int(t1[i])
-                self.t_row.append(self.t_row.a[a:b].copy())
-                self.t_col.append(self.t_col.a[a:b].copy())
-                self.t_val.append(self.t_val.a[a:b].copy())
-            start[i] = got
-        self.t_start.a[cands] = start
-        self.t_end.a[cands] = start + (t1 - t0)
 
     def _add_transitions(self, cands, row, col, val, bounds):
         """Store candidate ``cands[i]``'s transition, entries ``bounds[i]:bounds[i + 1]`` of
-        ``row``, ``col``, ``val``, once per distinct content: patches that differ in shape
-        alone (most keys beside creases, and every input face's in a regular region) share
-        their step's rows, so the table holds each once (a fifth of the entries on fandisk's
-        hybrid) and the carry reads fewer distinct ones. Contents are told apart by a 128-bit
-        hash of their entries (the weights by their bits), as keys are. Returns the hashes
-        (k, 2)."""
+        ``row``, ``col``, ``val``, once per distinct content: keys of other connectivity often
+        have the same step rows (the rows do not see a crease's far side, for one), so the
+        table holds each once and the carry reads fewer distinct ones. Contents are told apart
+        by a 128-bit hash of their entries (the weights by their bits), as keys are."""
         n = np.diff(bounds)
         start = np.empty(len(cands), np.int64)
         h = np.empty((len(cands), 2), np.uint64)  # 128 bits, as the keys'
@@ -662,7 +446,6 @@ class PatchTable:
         self.t_val.append(val[keep])
         self.t_start.a[cands] = start
         self.t_end.a[cands] = start + n
-        return h
 
     def fill_stencils(self, keys: np.ndarray):
         """The last interpolation's data of ``keys`` (unique, none yet): stencil vertices, their

@@ -174,9 +174,9 @@ def cut_children(p: Patches, plan, faces1: np.ndarray, child: Level, shapes_of, 
                                     np.asarray(within[1], dtype=np.int64), RINGS)
     nxt, corner_n, vsel, fkeys = cut_patches(child, corner1, node, f)
     cur = np.searchsorted(fkeys, np.arange(len(centre)) * len(faces1) + centre)
-    used, back = np.unique(f, return_inverse=True)
     fstart = np.searchsorted(node, np.arange(len(centre) + 1))
-    return nxt, corner_n, shapes_of(used)[back], cur, vsel, fstart, f
+    # Every face is equilateral in its own frame (the chart, ``_refiner/chart.py``).
+    return nxt, corner_n, np.repeat(EQUILATERAL[None], len(f), axis=0), cur, vsel, fstart, f
 
 
 def _edge_tags(level: Level, scheme: str):

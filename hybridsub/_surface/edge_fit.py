@@ -1,11 +1,11 @@
-"""Derivatives of points exactly on a split edge beside a √3 face of the hybrid: from a
-quadratic fit of exact values.
+"""Derivatives of points exactly on a split edge beside a √3 face (the hybrid's creases,
+boundaries and sharp/smooth interfaces, Kobbelt's boundary): from a quadratic fit of exact
+values.
 
-There the chart has no derivative across the edge: the edge is halved every step while the
-√3 faces beside it shrink by √3, so the last faces of a walk to the edge are needles across
-it and the chart shears along it by an amount that does not settle as the edge is approached
-(the walk's ``Du``, ``Dv`` there grow with the depth, the along-edge one lost digits, and
-normals were up to 90° off). The values are exact at every such point, so the derivatives
+There the surface has no derivative across the edge in the chart: the edge is halved
+(trisected) every step while the √3 faces beside it shrink by √3, and the difference quotient
+into the face grows without bound as the edge is approached (the walk's ``Du``, ``Dv`` there
+grow with the depth). The values are exact at every such point, so the derivatives
 are taken from a one-sided quadratic fit of values at one and two :data:`STEP` along the edge
 and into the face: the point's own value and four more walks, combined with fixed weights.
 ``project``'s Newton steps take these first derivatives too (with the walk's own second ones):
@@ -47,10 +47,10 @@ _FIT = np.array([
 
 
 def on_split_edge(depths: PointDepths, f: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The points (face ``f``, bary ``b``) on a split edge beside a √3 face, not at its ends:
-    their indices and the corner whose coordinate is zero there. The hybrid's only: on
-    Kobbelt's boundary (``"sqrt3"``) the walk's derivatives keep their digits."""
-    if depths.sqrt3 or not depths.edge.any() or not len(f):
+    """The points (face ``f``, bary ``b``) on a split edge beside a √3 face (the hybrid's, and
+    Kobbelt's boundary in ``"sqrt3"``), not at its ends: their indices and the corner whose
+    coordinate is zero there."""
+    if not depths.edge.any() or not len(f):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     k = np.argmin(b, axis=1)
     on = (b[np.arange(len(f)), k] < ON_EDGE) & (b.max(axis=1) < 1 - AT_CORNER)

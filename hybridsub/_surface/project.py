@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from .._input import RefineInput
 from .._topology import build_level
-from .._refiner import EQUILATERAL, barycentric, child_shapes, matrix_supports, onto_input_faces, refinement_of
+from .._refiner import FaceCharts, onto_input_faces, refinement_of
 from ._closest_kernels import (bin_faces, closest_among, closest_in_grid, face_rings, faces_within, ring_deviation,
                                survivor_components, survivor_minima)
 from .mask_plan import edge_sharpness
@@ -47,6 +47,9 @@ COARSE_GAP = 1e-5
 #: it, at these multiples of the distance (``_weak_minima``).
 WEAK = 0.5
 WEAK_STARTS = np.array([-0.5, -0.25, 0.25, 0.5])
+#: On a wall, a step along it that moves the point by more than this × the distance is taken
+#: before any step off it (``_newton_step``).
+WALL_FIRST = 1e-6
 #: How far a seed at a vertex starts inside its face (towards the centroid, in barycentric units).
 SEED_INSET = 0.01
 #: The longest Newton step in (u, v).
@@ -62,17 +65,16 @@ FAR, FAR_SEEDS = 1e9, 4
 @dataclasses.dataclass(frozen=True, eq=False)
 class SeedMesh:
     """The certificate's refined level: its faces, the matrix of its vertices over the control
-    vertices, each face's input face and corners there (``corners`` (m, 3, 3), barycentric over
-    ``inface``'s corners, in its unfolded chart), the matrix of its vertices' limit points, the
-    vertices that reach the limit surface over each face (CSR: ``face_rings``), the input's
+    vertices, its charts (points on its faces carried onto the input faces), the matrix of its
+    vertices' limit points, the vertices that reach the limit surface over each face (CSR:
+    ``face_rings``), the input's
     halfedge twins with creases and the boundary as walls (−1), the control vertices that
     faces use, the level's twins with its creases as walls, and the
     input's corner vertices (tagged, or on three walls or more)."""
 
     faces: np.ndarray
     matrix: sp.csr_matrix
-    inface: np.ndarray
-    corners: np.ndarray
+    charts: FaceCharts
     limits: sp.csr_matrix
     ring_start: np.ndarray
     ring: np.ndarray
@@ -96,18 +98,10 @@ def seed_setup(inp: RefineInput) -> SeedMesh:
     levels = seed_levels(inp.n_faces, inp.scheme)
     r = refinement_of(dataclasses.replace(inp, levels=levels))
     F, n = inp.faces, inp.n_vertices
-    twin = inp.level.twin
-    shape = np.repeat(EQUILATERAL[None], len(F), axis=0)
-    B = np.repeat(np.eye(3)[None], len(F), axis=0)
-    inface = np.arange(len(F))
-    for st in r.steps:  # as ``vertex_origins``, per face
-        ids, w = matrix_supports(st.matrix, n)
-        parent = st.face_parent
-        shape1 = child_shapes(F, twin, shape, st.faces, parent, ids, w)
-        B = barycentric(shape[parent][:, None], shape1) @ B[parent]
-        inface = inface[parent]
-        shape, F, n = shape1, st.faces, st.n_vertices
-        twin = build_level(F, n).twin
+    charts = FaceCharts(F, n, lambda A, k: build_level(A, k).twin)
+    for st in r.steps:
+        charts.step(st)
+    F, n = charts.F, charts.n
     faces = np.ascontiguousarray(F, dtype=np.int64)
     order = np.argsort(faces.ravel(), kind="stable")
     vf_start = np.zeros(n + 1, np.int64)
@@ -137,13 +131,13 @@ def seed_setup(inp: RefineInput) -> SeedMesh:
     h = np.flatnonzero((walls < 0) & ((inp.level.twin < 0) | (np.arange(len(walls)) < inp.level.twin)))
     ends = np.stack([inp.faces.ravel()[h], inp.faces[h // 3, (h % 3 + 1) % 3]])
     cone = inp.corner | (np.bincount(ends.ravel(), minlength=inp.n_vertices) >= 3)
-    level_walls = twin.copy()
+    level_walls = charts.twin.copy()
     creases = np.asarray(r.sharp_edges, np.int64).reshape(-1, 2)[np.isinf(np.asarray(r.sharpness, np.float64))]
     if len(creases):
         key = np.sort(creases, axis=1) @ np.array([n, 1])
         ends = np.sort(np.stack([faces.ravel(), np.roll(faces, -1, axis=1).ravel()], axis=1), axis=1) @ np.array([n, 1])
         level_walls[np.isin(ends, key)] = -1
-    return SeedMesh(faces, r.matrix.tocsr(), inface, B, sp.csr_matrix(L @ r.matrix), ring_start, ring, walls,
+    return SeedMesh(faces, r.matrix.tocsr(), charts, sp.csr_matrix(L @ r.matrix), ring_start, ring, walls,
                     np.unique(inp.faces), level_walls, cone)
 
 
@@ -210,11 +204,15 @@ def _newton_step(face, bary, walls, cone_at, r, Du, Dv, Duu, Duv, Dvv):
     for _ in range(2):
         for j in range(3):
             delta = (-du - dv, du, dv)[j]
-            out = on_wall[:, j] & (delta < 0)
+            eu, ev = _ALONG[j]
+            curv = a0 * eu * eu + 2 * b0 * eu * ev + c0 * ev * ev
+            t = (gu * eu + gv * ev) / np.where(curv > 0, curv, 1.0)
+            # On a wall the run first goes along it while that moves the point: across a split
+            # edge the chart has no derivative, and a step into the face decided by the fitted
+            # one would leave the wall before the point is right along it.
+            along = np.abs(t) * np.sqrt(np.maximum(curv, 0.0)) > WALL_FIRST * d
+            out = on_wall[:, j] & ((delta < 0) | along)
             if out.any():
-                eu, ev = _ALONG[j]
-                curv = a0 * eu * eu + 2 * b0 * eu * ev + c0 * ev * ev
-                t = (gu * eu + gv * ev) / np.where(curv > 0, curv, 1.0)
                 du, dv = np.where(out, t * eu, du), np.where(out, t * ev, dv)
     delta = np.stack([-du - dv, du, dv], axis=1)
     stuck = (on_wall & (delta < -1e-300)).any(axis=1)
@@ -430,8 +428,7 @@ def candidates(seeds: SeedMesh, state: LevelState, pts: np.ndarray, limit: np.nd
     lam2 = np.zeros((len(tri), 3))
     closest_among(np.ascontiguousarray(pts[point]), state.limits, faces, near, tri2, lam2,
                   np.full(len(tri), np.inf))
-    g = seeds.inface[tri2]
-    bary = np.einsum("ki,kij->kj", lam2, seeds.corners[tri2])
+    g, bary = seeds.charts.points(tri2, lam2)
     return point, g, bary, low
 
 
