@@ -262,14 +262,17 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
         trust[ib] = 1.0
         trust[idx[~better]] *= 0.25
         # Rejected trials lie on one ray from the best point. Two of them give the distance's
-        # slope there (its quadratic through them): where it rises at first order (a foot at a
-        # corner, or on a wall whose derivatives mislead the step), no shorter trial is nearer.
+        # slope there (its quadratic through them): where it rises at first order at a vertex or
+        # on a wall (a foot at a corner, or derivatives that mislead the step along a wall), no
+        # shorter trial is nearer. (Inside a face a short enough step is: next to a corner of
+        # the hybrid's creases the chart's derivatives change fast.)
         worse = idx[~better]
         s_new = (d[~better] - best_d[worse]) / tried[worse]
         s_old, t_old = slope[worse], 4.0 * tried[worse]
         g = s_new - (s_old - s_new) * tried[worse] / (t_old - tried[worse])
         rising = (s_new > 0) & (s_old > 0) & (g > 0.5 * s_new) & (d[~better] - best_d[worse] > 1e-12 * best_d[worse])
-        active[worse[rising]] = False
+        at_rim = (best_b[worse].max(axis=1) >= 1 - 1e-10) | (best_b[worse].min(axis=1) <= 1e-10)
+        active[worse[rising & at_rim]] = False
         slope[ib] = np.nan
         slope[worse] = s_new
         du, dv = _newton_step(best_f[idx], best_b[idx], walls, cone[F0[best_f[idx]]], R[idx],
