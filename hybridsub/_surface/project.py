@@ -55,7 +55,7 @@ SEED_INSET = 0.01
 #: The longest Newton step in (u, v).
 MAX_STEP = 0.5
 #: At most this many iterations at the full depth (each costs a full descent).
-FINE_ITER = 12
+FINE_ITER = 20
 #: Queries farther than this (in diagonals) from the box's centre are moved in along the ray to
 #: it, and keep the seeds of their FAR_SEEDS nearest input faces: the distance to their foot is
 #: then the least to rounding (``docs/limit.md``), and squared distances stay finite.
@@ -337,6 +337,38 @@ def _weak_minima(surface, X, q, face, bary, Qn, G, seeds: SeedMesh, max_iter: in
     return face, bary, Qn, G
 
 
+#: Seeds this near a cone vertex (largest barycentric coordinate at least CONE_NEAR at a
+#: corner vertex of the input) also start from the nearest of a fan of probes round it.
+CONE_NEAR = 0.7
+_PROBE_R = np.geomspace(3e-2, 1e-5, 11)
+_PROBE_T = np.array([0.01, 0.05, 0.15, 0.3, 0.5, 0.7, 0.85, 0.95, 0.99])
+
+
+def _cone_probes(surface, Xn, q, point, sf, sb, low, seeds, depth):
+    """Extra seeds next to corner vertices: the nearest of a fan of points round the corner
+    (distances ``_PROBE_R`` from it, ``_PROBE_T`` of the way across), one per seed there."""
+    F0 = surface._inp.faces
+    k = np.argmax(sb, axis=1)
+    near = np.flatnonzero((sb.max(axis=1) >= CONE_NEAR) & seeds.cone[F0[sf, k]])
+    if not len(near):
+        return point, sf, sb, low
+    R, T = (a.ravel() for a in np.meshgrid(_PROBE_R, _PROBE_T, indexing="ij"))
+    m = len(R)
+    kk = np.repeat(k[near], m)
+    b = np.zeros((len(near) * m, 3))
+    rr, tt = np.tile(R, len(near)), np.tile(T, len(near))
+    rows = np.arange(len(b))
+    b[rows, kk] = 1 - rr
+    b[rows, (kk + 1) % 3] = rr * tt
+    b[rows, (kk + 2) % 3] = rr * (1 - tt)
+    ff = np.repeat(sf[near], m)
+    P = surface._applied(ff, b, 1, depth, Xn, rule_depth=surface.depth)[0]
+    d = np.linalg.norm(q[np.repeat(point[near], m)] - P, axis=1).reshape(len(near), m)
+    j = np.argmin(d, axis=1)
+    pb = b.reshape(len(near), m, 3)[np.arange(len(near)), j]
+    return (np.r_[point, point[near]], np.r_[sf, sf[near]], np.r_[sb, pb], np.r_[low, low[near]])
+
+
 def _frame(X: np.ndarray, seeds: SeedMesh):
     """Centre and scale of the data: the certificate works in units of the diagonal of the box
     of the used control vertices (no overflow or underflow at any scale)."""
@@ -480,14 +512,16 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     # a Newton step from there goes nowhere useful (a run that belongs at the vertex returns).
     at = sb.max(axis=1) >= 1 - 1e-9
     sb[at] = (1 - SEED_INSET) * sb[at] + SEED_INSET / 3
-    many = q[point]
     coarse = min(COARSE_DEPTH, surface.depth)
+    point, sf, sb, low = _cone_probes(surface, Xn, q, point, sf, sb, low, seeds, coarse)
+    many = q[point]
     face, bary, d, Pc, _ = _iterate(surface, Xn, many, sf, sb, coarse, max_iter, COARSE_STEP, seeds, point, low,
                                     COARSE_GAP)
     # Every seed whose coarse foot is near the best goes on at the full depth, once per place.
     best = np.full(len(q), np.inf)
     np.minimum.at(best, point, d)
     go = np.flatnonzero(d <= best[point] + COARSE_GAP)
+    go = go[np.argsort(d[go], kind="stable")]  # (the nearest of a place goes on)
     _, once = np.unique(np.c_[point[go], np.round(Pc[go] / COARSE_GAP)], axis=0, return_index=True)
     go = go[once]
     point, face, bary = point[go], face[go], bary[go]
