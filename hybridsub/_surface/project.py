@@ -338,18 +338,20 @@ def _weak_minima(surface, X, q, face, bary, Qn, G, seeds: SeedMesh, max_iter: in
 
 
 #: Seeds this near a cone vertex (largest barycentric coordinate at least CONE_NEAR at a
-#: corner vertex of the input) also start from the nearest of a fan of probes round it.
-CONE_NEAR = 0.7
+#: corner vertex of the input) whose component may come within PROBE_WITHIN of the query
+#: (its lower bound, in diagonals) also start from the nearest of a fan of probes round it.
+CONE_NEAR, PROBE_WITHIN = 0.7, 0.05
 _PROBE_R = np.geomspace(3e-2, 1e-5, 11)
 _PROBE_T = np.array([0.01, 0.05, 0.15, 0.3, 0.5, 0.7, 0.85, 0.95, 0.99])
 
 
 def _cone_probes(surface, Xn, q, point, sf, sb, low, seeds, depth):
-    """Extra seeds next to corner vertices: the nearest of a fan of points round the corner
-    (distances ``_PROBE_R`` from it, ``_PROBE_T`` of the way across), one per seed there."""
+    """Extra seeds next to corner vertices, for queries near the surface (``CONE_NEAR``): the
+    nearest of a fan of points round the corner (distances ``_PROBE_R`` from it, ``_PROBE_T``
+    of the way across), one per seed there."""
     F0 = surface._inp.faces
     k = np.argmax(sb, axis=1)
-    near = np.flatnonzero((sb.max(axis=1) >= CONE_NEAR) & seeds.cone[F0[sf, k]])
+    near = np.flatnonzero((sb.max(axis=1) >= CONE_NEAR) & seeds.cone[F0[sf, k]] & (low < PROBE_WITHIN))
     if not len(near):
         return point, sf, sb, low
     R, T = (a.ravel() for a in np.meshgrid(_PROBE_R, _PROBE_T, indexing="ij"))
