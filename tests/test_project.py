@@ -204,3 +204,23 @@ def test_far_points_that_the_nearest_vertex_seeds_missed():
                   [53.55921345, 398.13558584, -104.81957861], [14.97759516, 349.22268056, -184.97871889]])
     Y = s.evaluate([955] * len(Q), [[1.51116200e-01, 8.48404413e-01, 4.79387163e-04]] * len(Q))
     assert_no_farther(s, Q, Y)
+
+
+def test_points_of_the_surface_next_to_a_corner_of_creases_project_onto_themselves():
+    """Next to a corner where three of the CAD cube's creases meet, inside √3 faces of the
+    hybrid, the distance to a surface point has narrow valleys beside the crease walls (in the
+    equilateral chart of branch `equilateral-chart` Newton from the certificate's seed ended on
+    a wall for 6 of these 200). Oracle: the points themselves."""
+    s = surface("cube-meshed", "hybrid")
+    V, F = s.vertices, s.faces
+    feat = hybridsub.detect_features(V, F, angle=30)
+    rng = np.random.default_rng(4)
+    at = np.flatnonzero(np.isin(F, feat.corners).any(axis=1))
+    face = np.concatenate([[1655], rng.choice(at, 199)])
+    k = np.argmax(np.isin(F[face], feat.corners), axis=1)
+    bary = rng.dirichlet([1, 1, 1], len(face)) * 10.0 ** rng.uniform(-3, -1, (len(face), 1))
+    bary[np.arange(len(face)), k] += 1 - bary.sum(axis=1)
+    bary[0] = [2.96534700e-04, 9.89268452e-01, 1.04350133e-02]
+    Y = s.evaluate(face, bary)
+    _, _, foot, _ = s.project(Y)
+    assert np.linalg.norm(foot - Y, axis=1).max() < 1e-10 * diagonal(s)

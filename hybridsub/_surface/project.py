@@ -488,6 +488,7 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     best = np.full(len(q), np.inf)
     np.minimum.at(best, point, d)
     go = np.flatnonzero(d <= best[point] + COARSE_GAP)
+    go = go[np.argsort(d[go], kind="stable")]  # (of a place, the nearest run goes on)
     _, once = np.unique(np.c_[point[go], np.round(Pc[go] / COARSE_GAP)], axis=0, return_index=True)
     go = go[once]
     point, face, bary = point[go], face[go], bary[go]
