@@ -491,6 +491,16 @@ def _survivors(pts, P, faces, eps, ring_start, ring, grid, bound):
     return tuple(np.concatenate(a) for a in zip(*out))
 
 
+def _nearest_per_place(point: np.ndarray, d: np.ndarray, P: np.ndarray, best: np.ndarray) -> np.ndarray:
+    """The coarse runs that go on: those within ``COARSE_GAP`` of their query's ``best``
+    distance, of the runs of one query whose feet ``P`` share a cell of ``COARSE_GAP`` the
+    nearest (indices into the runs)."""
+    go = np.flatnonzero(d <= best[point] + COARSE_GAP)
+    go = go[np.argsort(d[go], kind="stable")]
+    _, once = np.unique(np.c_[point[go], np.round(P[go] / COARSE_GAP)], axis=0, return_index=True)
+    return go[once]
+
+
 def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     """``(face, bary, Q, dist)`` of the points ``pts`` on the limit surface of ``surface`` with controls ``X``."""
     seeds = surface._seed_setup()
@@ -522,10 +532,7 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     # Every seed whose coarse foot is near the best goes on at the full depth, once per place.
     best = np.full(len(q), np.inf)
     np.minimum.at(best, point, d)
-    go = np.flatnonzero(d <= best[point] + COARSE_GAP)
-    go = go[np.argsort(d[go], kind="stable")]  # (the nearest of a place goes on)
-    _, once = np.unique(np.c_[point[go], np.round(Pc[go] / COARSE_GAP)], axis=0, return_index=True)
-    go = go[once]
+    go = _nearest_per_place(point, d, Pc, best)
     point, face, bary = point[go], face[go], bary[go]
     face, bary, d, Qn, G = _iterate(surface, Xn, q[point], face, bary, surface.depth, min(max_iter, FINE_ITER),
                                     FINE_STEP, seeds)
