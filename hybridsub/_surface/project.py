@@ -19,6 +19,7 @@ import hashlib
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from .._input import RefineInput
 from .._topology import build_level
@@ -52,6 +53,10 @@ WEAK_STARTS = np.array([-0.5, -0.25, 0.25, 0.5])
 WALL_FIRST = 1e-6
 #: How far a seed at a vertex starts inside its face (towards the centroid, in barycentric units).
 SEED_INSET = 0.01
+#: Feet within NEAR_EDGE (barycentric) of an edge of their face whose residual has a part
+#: above POLISH_TOL × (1 + distance) in the tangent plane get at most POLISH_ITER rounds of
+#: ``_polish_near_edges`` (there the chart's derivatives hold only within part of a step).
+NEAR_EDGE, POLISH_ITER, POLISH_TOL = 1e-3, 12, 1e-12
 #: The longest Newton step in (u, v).
 MAX_STEP = 0.5
 #: At most this many iterations at the full depth (each costs a full descent).
@@ -69,8 +74,9 @@ class SeedMesh:
     vertices' limit points, the vertices that reach the limit surface over each face (CSR:
     ``face_rings``), the input's
     halfedge twins with creases and the boundary as walls (−1), the control vertices that
-    faces use, the level's twins with its creases as walls, and the
-    input's corner vertices (tagged, or on three walls or more)."""
+    faces use, the level's twins with its creases as walls, the
+    input's corner vertices (tagged, or on three walls or more), and each input face's side:
+    its component of faces joined across edges that are not walls."""
 
     faces: np.ndarray
     matrix: sp.csr_matrix
@@ -82,6 +88,7 @@ class SeedMesh:
     used: np.ndarray
     level_walls: np.ndarray
     cone: np.ndarray
+    side: np.ndarray
 
 
 def seed_levels(n_faces: int, scheme: str) -> int:
@@ -137,8 +144,12 @@ def seed_setup(inp: RefineInput) -> SeedMesh:
         key = np.sort(creases, axis=1) @ np.array([n, 1])
         ends = np.sort(np.stack([faces.ravel(), np.roll(faces, -1, axis=1).ravel()], axis=1), axis=1) @ np.array([n, 1])
         level_walls[np.isin(ends, key)] = -1
+    across = np.flatnonzero(walls >= 0)
+    n0 = inp.n_faces
+    _, side = connected_components(sp.csr_matrix((np.ones(len(across)), (across // 3, walls[across] // 3)),
+                                                 shape=(n0, n0)), directed=False)
     return SeedMesh(faces, r.matrix.tocsr(), charts, sp.csr_matrix(L @ r.matrix), ring_start, ring, walls,
-                    np.unique(inp.faces), level_walls, cone)
+                    np.unique(inp.faces), level_walls, cone, side)
 
 
 def _hessian(r, Du, Dv, Duu, Duv, Dvv):
@@ -299,6 +310,96 @@ def _iterate(surface, X, pts, face, bary, depth, max_iter, stop, seeds, point=No
             active[out] = False
             best_d[out] = np.inf
     return best_f, best_b, best_d, Pb, G
+
+
+def _tangential(r: np.ndarray, G: np.ndarray) -> np.ndarray:
+    """The part of the residuals ``r`` (k, 3) in the tangent planes of the derivatives ``G``
+    (k, ≥2, 3): zero at a foot where the distance is stationary."""
+    N = np.cross(G[:, 0], G[:, 1])
+    size = np.linalg.norm(N, axis=1)
+    N = N / np.where(size > 0, size, 1.0)[:, None]
+    return r - np.einsum("ij,ij->i", r, N)[:, None] * N
+
+
+def _polish_near_edges(surface, X, q, face, bary, Qn, G):
+    """Gauss–Newton steps from feet within ``NEAR_EDGE`` of an edge of their face (or on it)
+    where the distance is not stationary (the residual has a part in the tangent plane), each on the
+    chart's derivatives at one of a fan of points round the foot (``_FAN``), the nearest trial
+    taken. Beside the hybrid's split edges the equilateral chart is piecewise smooth at the
+    scale of the walk's last faces and sheared (a surface point 3e-7 away can be 5e-5 of a
+    face away along the edge); a Newton run on the derivatives at the foot can end on a kink
+    there, 1e-7 … 1e-6 diagonals from the true foot, while the derivatives of the piece that
+    leads to it are those of a point next to it; a run that a step cut short ended on a crease
+    wall 1e-5 of a face from its foot, where the wall's derivatives into the face are a fit.
+    The trials stay inside the face; only nearer points are taken."""
+    r = q - Qn
+    d = np.linalg.norm(r, axis=1)
+    loose = np.linalg.norm(_tangential(r, G), axis=1) > POLISH_TOL * (1 + d)
+    rows = np.flatnonzero((bary.min(axis=1) < NEAR_EDGE) & loose)
+    if not len(rows):
+        return face, bary, Qn, G
+    f, b, x, P, d = face[rows], bary[rows].copy(), q[rows], Qn[rows].copy(), d[rows]
+    moved = np.zeros(len(rows), bool)
+    live = np.arange(len(rows))
+    n = len(_FAN)
+    for _ in range(POLISH_ITER):
+        if not len(live):
+            break
+        k, bl = len(live), b[live]
+        at = (bl[None] + _FAN[:, None]).reshape(-1, 3)
+        fl = np.tile(f[live], n)
+        inside = at.min(axis=1) > 0
+        Du, Dv = np.zeros((2, len(at), 3))
+        if inside.any():
+            Du[inside], Dv[inside] = surface._applied(fl[inside], at[inside], 3, surface.depth, X,
+                                                      rule_depth=surface.depth)[1:3]
+        r = np.tile(x[live] - P[live], (n, 1))
+        a, c, e = (np.einsum("ij,ij->i", *pair) for pair in ((Du, Du), (Dv, Dv), (Du, Dv)))
+        gu, gv = np.einsum("ij,ij->i", Du, r), np.einsum("ij,ij->i", Dv, r)
+        det = a * c - e * e
+        ok = inside & (det > 1e-30 * a * c)
+        det = np.where(ok, det, 1.0)
+        du, dv = np.where(ok, (c * gu - e * gv) / det, 0.0), np.where(ok, (a * gv - e * gu) / det, 0.0)
+        delta = np.stack([-du - dv, du, dv], axis=1)
+        bt = np.tile(bl, (n, 1))
+        cut = np.where(delta < 0, 0.999 * bt / np.where(delta < 0, -delta, 1.0), 1.0).min(axis=1)
+        delta *= np.minimum(cut, 1.0)[:, None]
+        m = len(_POLISH_SHORTER)
+        nb = (bt[None] + _POLISH_SHORTER[:, None, None] * delta[None]).reshape(-1, 3)  # (m × n × k, 3)
+        ok = np.tile(ok, m)
+        dn = np.full(len(nb), np.inf)
+        Pn = np.zeros_like(nb)
+        if ok.any():
+            Pn[ok] = surface._applied(np.tile(fl, m)[ok], nb[ok], 1, surface.depth, X, rule_depth=surface.depth)[0]
+            dn[ok] = np.linalg.norm(np.tile(x[live], (m * n, 1))[ok] - Pn[ok], axis=1)
+        dn, Pn, nb = dn.reshape(m * n, k), Pn.reshape(m * n, k, 3), nb.reshape(m * n, k, 3)
+        j = np.argmin(dn, axis=0)
+        cols = np.arange(k)
+        better = dn[j, cols] < d[live]
+        i = live[better]
+        b[i], P[i], d[i], moved[i] = nb[j, cols][better], Pn[j, cols][better], dn[j, cols][better], True
+        live = live[better]
+    i = rows[moved]
+    if len(i):
+        bary[i] = b[moved]
+        out = surface._applied(face[i], bary[i], 6, surface.depth, X, rule_depth=surface.depth)
+        Qn[i] = out[0]
+        G[i] = np.stack(list(out[1:]), axis=1)
+    return face, bary, Qn, G
+
+
+def _fan(radii, n_angles: int) -> np.ndarray:
+    """Barycentric offsets of points round a foot: ``n_angles`` directions in (u, v) at each of
+    ``radii``, and the foot itself first."""
+    t = np.linspace(0, 2 * np.pi, n_angles, endpoint=False)
+    du, dv = (np.outer(radii, f(t)).ravel() for f in (np.cos, np.sin))
+    return np.vstack([[0.0, 0.0, 0.0], np.c_[-du - dv, du, dv]])
+
+
+#: Where ``_polish_near_edges`` takes the chart's derivatives round a foot.
+_FAN = _fan(np.array([1e-8, 1e-6, 1e-4]), 16)
+#: Each of its steps is tried whole and shortened by these factors.
+_POLISH_SHORTER = np.array([1.0, 0.5, 0.25])
 
 
 def _weak_minima(surface, X, q, face, bary, Qn, G, seeds: SeedMesh, max_iter: int):
@@ -491,13 +592,17 @@ def _survivors(pts, P, faces, eps, ring_start, ring, grid, bound):
     return tuple(np.concatenate(a) for a in zip(*out))
 
 
-def _nearest_per_place(point: np.ndarray, d: np.ndarray, P: np.ndarray, best: np.ndarray) -> np.ndarray:
+def _nearest_per_place(point: np.ndarray, d: np.ndarray, P: np.ndarray, best: np.ndarray,
+                       side: np.ndarray | None = None) -> np.ndarray:
     """The coarse runs that go on: those within ``COARSE_GAP`` of their query's ``best``
-    distance, of the runs of one query whose feet ``P`` share a cell of ``COARSE_GAP`` the
-    nearest (indices into the runs)."""
+    distance, of the runs of one query whose feet ``P`` share a cell of ``COARSE_GAP`` (and a
+    ``side`` of the walls, if given) the nearest (indices into the runs). Runs on the two sides
+    of a crease can end in one cell: at the coarse depth the one across the crease can be the
+    nearer, and it cannot reach a foot on this side."""
     go = np.flatnonzero(d <= best[point] + COARSE_GAP)
     go = go[np.argsort(d[go], kind="stable")]
-    _, once = np.unique(np.c_[point[go], np.round(P[go] / COARSE_GAP)], axis=0, return_index=True)
+    side = np.zeros(len(point), np.int64) if side is None else side
+    _, once = np.unique(np.c_[point[go], side[go], np.round(P[go] / COARSE_GAP)], axis=0, return_index=True)
     return go[once]
 
 
@@ -532,10 +637,12 @@ def closest_points(surface, X: np.ndarray, pts: np.ndarray, max_iter: int):
     # Every seed whose coarse foot is near the best goes on at the full depth, once per place.
     best = np.full(len(q), np.inf)
     np.minimum.at(best, point, d)
-    go = _nearest_per_place(point, d, Pc, best)
+    go = _nearest_per_place(point, d, Pc, best, seeds.side[face])
     point, face, bary = point[go], face[go], bary[go]
     face, bary, d, Qn, G = _iterate(surface, Xn, q[point], face, bary, surface.depth, min(max_iter, FINE_ITER),
                                     FINE_STEP, seeds)
+    face, bary, Qn, G = _polish_near_edges(surface, Xn, q[point], face, bary, Qn, G)
+    d = np.linalg.norm(q[point] - Qn, axis=1)
     order = np.lexsort((d, point))
     pick = order[np.r_[True, point[order][1:] != point[order][:-1]]]
     face, bary, Qn, G = face[pick], bary[pick], Qn[pick], G[pick]
