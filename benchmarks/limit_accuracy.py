@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
@@ -21,30 +22,14 @@ from _bench import ROOT
 
 import hybridsub
 
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+from test_limit_surface import _near_features as near_features  # noqa: E402  (the tests' sampler, not a copy)
+
 MESH_WITH_BORDER = os.path.join(ROOT, "tests", "data", "mesh_with_border.off")
 
 
 def diag(V):
     return float(np.linalg.norm(V.max(0) - V.min(0)))
-
-
-def near_features(s, n, seed):
-    """As ``tests/test_limit_surface.py``'s ``_near_features``."""
-    rng = np.random.default_rng(seed)
-    f = rng.choice(np.flatnonzero(s._depths.any), n)
-    k, mode = rng.integers(0, 3, n), rng.integers(0, 3, n)
-    r = 10.0 ** rng.uniform(-12, 0, n)
-    r[rng.random(n) < 0.05] = 0.0
-    b = rng.dirichlet([1, 1, 1], n)
-    i, k1, k2 = np.arange(n), (k + 1) % 3, (k + 2) % 3
-    to_corner = b.copy()
-    to_corner[i, k1] *= r
-    to_corner[i, k2] *= r
-    to_edge = b.copy()
-    to_edge[i, k2] *= r
-    for B in (to_corner, to_edge):
-        B /= B.sum(axis=1, keepdims=True)
-    return f, np.where((mode == 0)[:, None], to_corner, np.where((mode == 1)[:, None], to_edge, b))
 
 
 def random_points():
