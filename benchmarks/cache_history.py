@@ -20,6 +20,7 @@ import numpy as np
 from _bench import load  # noqa: E402
 
 import hybridsub  # noqa: E402
+import hybridsub._surface.surface as surface_module  # noqa: E402
 
 
 def main():
@@ -37,7 +38,9 @@ def main():
         other = rng.integers(0, len(m.F), n), rng.dirichlet([1, 1, 1], n)
         for scheme in a.schemes:
             tags = {} if scheme == "sqrt3" else dict(sharp_edges=m.creases, corners=m.corners)
+            surface_module._TABLES.clear()  # a fresh process's patch table
             fresh = hybridsub.LimitSurface(m.V, m.F, scheme=scheme, **tags).evaluate(face, bary, derivatives=True)
+            surface_module._TABLES.clear()
             s = hybridsub.LimitSurface(m.V, m.F, scheme=scheme, **tags)
             s.evaluate(*other, derivatives=True)
             warm = s.evaluate(face, bary, derivatives=True)

@@ -19,6 +19,16 @@ DATA = os.path.join(os.path.dirname(__file__), "data")
 sys.path.insert(0, os.path.dirname(__file__))
 
 
+@pytest.fixture(autouse=True)
+def _no_shared_patch_tables(monkeypatch):
+    """Each test starts without the patch tables surfaces share (``_TABLES`` in
+    hybridsub/_surface/surface.py), as a fresh process does: what one test's surfaces made,
+    or set on their tables, does not reach another test."""
+    import hybridsub._surface.surface as surface
+
+    monkeypatch.setattr(surface, "_TABLES", {})
+
+
 def load_mesh(name: str):
     """(V, F) of tests/data/NAME.off, exactly as stored (no merging, no reordering)."""
     from hybridsub._io import read_off

@@ -1,6 +1,8 @@
 """The patch cache behind LimitSurface (issue 14's speed): the cached walk gives the direct
 descent's rows, whatever the numbering, orientation or order of evaluation."""
 
+import os
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -9,6 +11,7 @@ from test_limit_surface import CASES, FAN_F, FAN_V, OCTA_F, OCTA_V
 import hybridsub
 from hybridsub._surface import cache as C
 from hybridsub._surface import descent as D
+from hybridsub._surface import surface
 from hybridsub._surface.regular import is_regular, regular_torus
 
 
@@ -84,6 +87,7 @@ def test_a_shared_cache_gives_what_a_fresh_one_gives(name):
     warm.evaluate(*_points(F, 80, seed=2), derivatives=True)  # fills the cache with other points
     n_before = warm._table.n_keys
     got = warm.evaluate(face, bary, derivatives=True)
+    surface._TABLES.clear()  # a table of its own
     new = hybridsub.LimitSurface(V, F, **kw)
     fresh = new.evaluate(face, bary, derivatives=True)
     assert warm._table.n_keys - n_before < new._table.n_keys  # some keys were found again
@@ -92,6 +96,83 @@ def test_a_shared_cache_gives_what_a_fresh_one_gives(name):
     again = warm.evaluate(face, bary, derivatives=True)  # every key known: same bits
     for a, b in zip(got, again):
         assert np.array_equal(a, b)
+
+
+def _shipped_kinds():
+    """fandisk and the CAD cube with their 30° creases and corners, mesh_with_border (open)."""
+    out = {}
+    for name in ("fandisk", "cube-meshed", "mesh_with_border"):
+        if name == "fandisk":
+            V, F = hybridsub.load_example()
+        else:
+            m = hybridsub.read_mesh(os.path.join(os.path.dirname(__file__), "data", f"{name}.off"))
+            V, F = m.vertices, m.faces
+        feat = hybridsub.detect_features(V, F, 30)
+        out[name] = (V, F, dict(sharp_edges=feat.sharp_edges, corners=feat.corners))
+    return out
+
+
+@pytest.mark.parametrize("scheme", ["loop", "sqrt3", "hybrid"])
+def test_surfaces_of_one_kind_share_their_patches_to_the_bit(scheme):
+    """A new surface takes the patch table its kind's surfaces filled before (other meshes,
+    other points): it builds fewer patches, and its points are those of a fresh process, to
+    the bit, in whatever order the meshes come."""
+    meshes = _shipped_kinds()
+    pts = {k: _points(F, 400, seed=21) for k, (_, F, _) in meshes.items()}
+
+    def run(order):
+        surface._TABLES.clear()
+        out, keys = {}, {}
+        for k in order:
+            V, F, kw = meshes[k]
+            s = hybridsub.LimitSurface(V, F, scheme=scheme, **({} if scheme == "sqrt3" else kw))
+            before = s._table.n_keys
+            out[k] = s.evaluate(*pts[k], derivatives=True)
+            keys[k] = (before, s._table.n_keys - before)
+        return out, keys
+
+    alone = {}
+    for k in meshes:
+        got, keys = run([k])
+        alone[k] = got[k]
+        n_alone = keys[k][1]
+    for order in (list(meshes), list(meshes)[::-1]):
+        got, keys = run(order)
+        for k in meshes:
+            for a, b in zip(got[k], alone[k]):
+                assert np.array_equal(a, b), (order, k)
+        assert keys[order[-1]][0] > 0  # the last started from the others' patches
+    assert keys[order[-1]][1] < n_alone  # and built fewer of its own
+
+
+def test_surfaces_sharing_a_table_in_threads_give_the_serial_bits():
+    """Surfaces of one kind evaluated at once from several Python threads (the shared table
+    is filled under its lock) give what they give one after another."""
+    import threading
+
+    meshes = _shipped_kinds()
+    pts = {k: _points(F, 1500, seed=22) for k, (_, F, _) in meshes.items()}
+    serial = {k: hybridsub.LimitSurface(V, F, **kw).evaluate(*pts[k], derivatives=True)
+              for k, (V, F, kw) in meshes.items()}
+    surface._TABLES.clear()
+    got, errors = {}, []
+
+    def work(k):
+        try:
+            V, F, kw = meshes[k]
+            got[k] = hybridsub.LimitSurface(V, F, **kw).evaluate(*pts[k], derivatives=True)
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in meshes]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    for k in meshes:
+        for a, b in zip(got[k], serial[k]):
+            assert np.array_equal(a, b), k
 
 
 @pytest.mark.parametrize("scheme", ["loop", "sqrt3", "hybrid"])
@@ -156,6 +237,7 @@ def test_transitions_are_stored_once_per_content(name, shared):
     plain = hybridsub.LimitSurface(V, F, depth=10, **kw)
     plain._table._t_index = _NothingShared()
     ref = plain.evaluate(face, bary, derivatives=True)
+    surface._TABLES.clear()  # a table of its own
     s = hybridsub.LimitSurface(V, F, depth=10, **kw)
     got = s.evaluate(face, bary, derivatives=True)
     for a, b in zip(got, ref):
@@ -216,6 +298,7 @@ def test_regular_loop_patches_stop_with_the_exact_quartic(mesh):
     face, bary = _points(F, 80, seed=7)
     s = hybridsub.LimitSurface(V, F, **kw)
     P, Du, Dv = s.evaluate(face, bary, derivatives=True)
+    surface._TABLES.clear()  # a table of its own
     deep = hybridsub.LimitSurface(V, F, depth=24, **kw)
     deep._table.regular_stop = False
     Pd, Dud, Dvd = deep.evaluate(face, bary, derivatives=True)
@@ -342,6 +425,7 @@ def test_threaded_walk_gives_the_serial_bits(mesh, monkeypatch):
     got = {}
     for threaded in (False, True):
         monkeypatch.setattr(topo, "PARALLEL_MIN", 0 if threaded else 10**12)
+        surface._TABLES.clear()  # filled afresh
         got[threaded] = hybridsub.LimitSurface(V, F, **kw).evaluate(face, bary, derivatives=True)
     for a, b in zip(got[False], got[True]):
         assert np.array_equal(a, b)

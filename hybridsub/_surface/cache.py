@@ -27,6 +27,8 @@ representatives.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from .._topology import Level
@@ -174,6 +176,14 @@ class PatchTable:
         self._kept = []  # the last steps refined (:meth:`_refine`), for cutting their children
         self._order = []  # the keys last given steps, by parity: the order children are registered in
         self._t_index: dict[tuple, int] = {}  # a transition's contents (hashed) → its first entry
+        self.lock = threading.RLock()  # held while a walk fills the table
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in vars(self).items() if k != "lock"}
+
+    def __setstate__(self, state: dict) -> None:
+        vars(self).update(state)
+        self.lock = threading.RLock()
+
     @property
     def nbytes(self) -> int:
         """What the cache holds: its arrays' capacity (they grow by half), its two

@@ -4,6 +4,7 @@ derivatives, normals and closest points; every value a sparse row over the contr
 from __future__ import annotations
 
 import dataclasses
+import threading
 import warnings
 
 import numpy as np
@@ -24,6 +25,14 @@ CHUNK = 20000
 FIRST_CHUNK = 4096
 #: The patch cache is emptied between chunks once it holds about this many bytes.
 CACHE_BYTES = 2**28
+
+#: The patch cache of each kind of surface (scheme, Loop weights, tolerance, level bound,
+#: corners as sharpness): its keys are patch types, not this mesh's patches, so a new surface
+#: starts from what the surfaces of its kind made before (a repeated `subdivide_adaptive`, fit
+#: or evaluation on the frames of an animation builds no patch twice). At most one per kind,
+#: each under ``CACHE_BYTES``; a surface whose cache fills starts a new one for its kind.
+_TABLES: dict[tuple, PatchTable] = {}
+_TABLES_LOCK = threading.Lock()
 
 
 def _default_depth(scheme: str) -> int:
@@ -185,9 +194,15 @@ class LimitSurface:
         return f, b / total[:, None]
 
     def _new_cache(self):
-        """An empty patch cache (``_surface/cache.py``): filled as points are evaluated."""
-        self._table = PatchTable(self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels,
-                                 vertex_sharpness=self._inp.corner_sharpness is not None)
+        """The patch cache of this kind of surface (``_surface/cache.py``), a new one when it
+        is full: filled as points are evaluated, shared with the surfaces of the same kind."""
+        kind = (self._inp.scheme, self._inp.loop_weights, self._tol, self._max_levels,
+                self._inp.corner_sharpness is not None)
+        with _TABLES_LOCK:
+            table = _TABLES.get(kind)
+            if table is None or table.nbytes > CACHE_BYTES:
+                table = _TABLES[kind] = PatchTable(*kind[:4], vertex_sharpness=kind[4])
+        self._table = table
         self._starts = StartKeys(self._inp, self._table)
         self._chunk = getattr(self, "_chunk", CHUNK)
 
@@ -249,7 +264,8 @@ class LimitSurface:
                 self._new_cache()
             size = self._chunk if self._table.n_keys else min(self._chunk, FIRST_CHUNK)
             before = self._table.nbytes
-            out.append(work(f[i:i + size], b[i:i + size]))
+            with self._table.lock:  # shared with other surfaces, perhaps in other threads
+                out.append(work(f[i:i + size], b[i:i + size]))
             done = min(size, len(f) - i)
             i += size
             grown = max(self._table.nbytes - before, 0) / done
