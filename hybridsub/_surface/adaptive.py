@@ -2,8 +2,9 @@
 or a tolerance) and :func:`subdivide_adaptive` (positions within a tolerance of the limit).
 
 The engine is :mod:`hybridsub._refiner.adaptive`; this module adds the error criterion, which
-needs the limit surface: every output face is compared with the limit surface over it at the
-face's corners, edge midpoints and centroid, in the parameter chart (``docs/adaptive.md``).
+needs the limit surface: every output face is compared with the limit surface over it, its
+corners with their limit positions, the surface points at its edge midpoints and centroid
+with the output triangles round it (``docs/adaptive.md``).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from .._refiner import FaceCharts, Refinement, refine, without_holes
 from .._refiner.adaptive import AdaptiveMesh, RegionStep, adaptive_refinement
 from .._topology import build_level
 from .._typing import ArrayLike, Boundary, LoopWeights, MemoryLimit, NonManifold, Scheme, UVMode
+from ._closest_kernels import closest_among
 from .local import corner_mask, semi_sharp
 from .mask_plan import plan_level
 from .surface import LimitSurface
@@ -91,14 +93,46 @@ def spread_one_ring(mesh: AdaptiveMesh, want: np.ndarray) -> np.ndarray:
     return np.maximum(want, at_v[mesh.faces].max(axis=1))
 
 
+#: The barycentric coordinates of the midpoint of each edge i → i + 1 of a face.
+_EDGE_MIDPOINTS = np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]])
+
+
+def distance_to_output(S: np.ndarray, P: np.ndarray, faces: np.ndarray, twin: np.ndarray, near: np.ndarray,
+                       hidden: np.ndarray | None = None) -> np.ndarray:
+    """How far each surface point ``S[i]`` (m, 3) is from the output mesh ``(P, faces)``, as
+    far as face ``near[i]`` and its edge neighbours (``twin``, halfedge twins, -1 on the
+    boundary) show: the distance to the nearest of those triangles, an upper bound of the
+    distance to the whole output, and chart-free (a surface point the chart puts to the side
+    of its face is measured against the face it lies over). Faces ``hidden`` are not output.
+
+    Examples
+    --------
+    >>> P = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    >>> G = np.array([[0, 1, 2], [1, 3, 2]]); twin = np.array([-1, 5, -1, -1, -1, 1])
+    >>> distance_to_output(np.array([[0.9, 0.9, 0.1]]), P, G, twin, np.array([0])).round(6).tolist()
+    [0.1]
+    """
+    cand = np.c_[near, np.where(twin[3 * near[:, None] + np.arange(3)] >= 0,
+                                twin[3 * near[:, None] + np.arange(3)] // 3, -1)]
+    if hidden is not None:
+        cand = np.where((cand >= 0) & hidden[np.maximum(cand, 0)], -1, cand)
+    cand = -np.sort(-cand, axis=1)  # (−1 ends a row)
+    d2 = np.full(len(S), np.inf)
+    closest_among(np.ascontiguousarray(S, dtype=np.float64), np.ascontiguousarray(P, dtype=np.float64),
+                  np.ascontiguousarray(faces, dtype=np.int64), np.ascontiguousarray(cand),
+                  np.full(len(S), -1, np.int64), np.zeros((len(S), 3)), d2)
+    return np.sqrt(d2)
+
+
 class Criterion:
     """The error criterion, called by the driver at every level (see ``OnLevel``).
 
     Follows the refinement's positions (level positions, ``S @ V``) and every face's chart;
-    the error of a face is the largest distance between a point of the flat triangle (its
-    corners at the limit positions with ``limit``, else at their level positions) and the
-    limit surface at the same parameter, over its corners, edge midpoints and centroid. Errors are taken once, when a
-    face is made: a face's vertices never move afterwards.
+    the error of a face (its corners at the limit positions with ``limit``, else at their
+    level positions) is the largest of its corners' distances to their limit positions and
+    the distances of the surface points at its edge midpoints and centroid to the output
+    (:func:`distance_to_output`). Errors are taken once, when a face is made: a face's
+    vertices never move afterwards.
     """
 
     def __init__(self, inp: RefineInput, X: np.ndarray, surface: LimitSurface, tolerance: float, limit: bool):
@@ -211,16 +245,17 @@ class Criterion:
         self.known[v] = True
 
     def _errors(self, mesh: AdaptiveMesh, fresh: np.ndarray) -> np.ndarray:
-        """The error of each face of ``fresh``: its corners, its edge midpoints (each edge
-        once) and its centroid against the surface."""
+        """The error of each face of ``fresh``: its corners against their limit positions,
+        and the surface points at its edge midpoints (each edge once) and its centroid
+        against the output faces there (:func:`distance_to_output`)."""
         F = mesh.faces
         need = np.unique(F[fresh].ravel())
         need = need[~self.known[need]]
         if len(need):
             self._limits(mesh, fresh, need)
         out = self.Q if self.limit else self.P
-        corners = out[F[fresh]]  # (k, 3, 3)
-        err = np.linalg.norm(corners - self.Q[F[fresh]], axis=2).max(axis=1)
+        err = np.linalg.norm(out[F[fresh]] - self.Q[F[fresh]], axis=2).max(axis=1)
+        hidden = None if self.inp.hole is None else self.inp.hole[mesh.face_parent]
         # Edge midpoints: each edge once, from the face of its higher halfedge when both are fresh.
         h = (3 * fresh[:, None] + np.arange(3)).ravel()
         t = mesh.twin[h]
@@ -228,21 +263,14 @@ class Criterion:
         is_fresh[fresh] = True
         own = (t < 0) | (t < h) | ~is_fresh[np.maximum(t, 0) // 3]
         ho = h[own]
-        mids = np.zeros((len(ho), 3))
-        i = ho % 3
-        mids[np.arange(len(ho)), i] = 0.5
-        mids[np.arange(len(ho)), (i + 1) % 3] = 0.5
-        f, b = self.charts.points(ho // 3, mids)
-        Fo = F[ho // 3]
-        flat = 0.5 * (out[Fo[np.arange(len(ho)), i]] + out[Fo[np.arange(len(ho)), (i + 1) % 3]])
-        e_own = np.linalg.norm(self.surface.evaluate(f, b) - flat, axis=1)
+        f, b = self.charts.points(ho // 3, _EDGE_MIDPOINTS[ho % 3])
         e_half = np.zeros(3 * len(F))
-        e_half[ho] = e_own
+        e_half[ho] = distance_to_output(self.surface.evaluate(f, b), out, F, mesh.twin, ho // 3, hidden)
         shared = ~own & (t >= 0)
         e_half[h[shared]] = e_half[t[shared]]
         err = np.maximum(err, e_half[h].reshape(-1, 3).max(axis=1))
         f, b = self.charts.points(fresh, np.full((len(fresh), 3), 1.0 / 3.0))
-        e_c = np.linalg.norm(self.surface.evaluate(f, b) - corners.mean(axis=1), axis=1)
+        e_c = distance_to_output(self.surface.evaluate(f, b), out, F, mesh.twin, fresh, hidden)
         return np.maximum(err, e_c)
 
     def positions(self, mesh: AdaptiveMesh) -> np.ndarray:
@@ -338,11 +366,11 @@ def uniform_error(V: ArrayLike, F: ArrayLike, levels: int, *, only: ArrayLike | 
     for st in r.steps:
         charts.step(st)
     surface = LimitSurface(X, F, scheme=scheme, **tags)
-    Q = np.array([[.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3]])
-    f, b = charts.points(np.repeat(pick, len(Q)), np.tile(Q, (len(pick), 1)))
-    S = surface.evaluate(f, b).reshape(len(pick), len(Q), 3)
-    T = np.einsum("sj,fjc->fsc", Q, P[G[pick]])
-    return float(np.linalg.norm(S - T, axis=2).max(initial=0.0))
+    Q = np.vstack([_EDGE_MIDPOINTS, np.full(3, 1 / 3)])
+    near = np.repeat(pick, len(Q))
+    f, b = charts.points(near, np.tile(Q, (len(pick), 1)))
+    d = distance_to_output(surface.evaluate(f, b), P, G, build_level(G, len(P)).twin, near)
+    return float(d.max(initial=0.0))
 
 
 def _gate(F, sharp_edges, levels, n_vertices, scheme, sharpness, sharp_faces, corners, loop_weights,
