@@ -447,10 +447,10 @@ def fig_adaptive(out, quick):
     feat = hybridsub.detect_features(V, F, angle=30)
     tags = dict(sharp_edges=feat.sharp_edges, corners=feat.corners)
     diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-    rel = 5e-3 if quick else 5e-4
+    rel = 5e-3 if quick else 2e-4
     res = adaptive_result(V, F, tolerance=rel * diag, **tags)
     r = res.refinement
-    L = 1
+    L = 0
     while uniform_error(V, F, L, **tags) > res.tolerance and L < (1 if quick else 4):
         L += 1
     U = hybridsub.refine(F, levels=L, **tags)
